@@ -1,0 +1,368 @@
+"""The normalized frame S_i of a course and the choice of the end velocity (eqs. 10-14).
+
+In ``S_i`` the course's initial deviation is ``|D_i(0)|/sqrt3 (1, 1, 1)`` (all components
+equal and positive) and the next course's initial deviation ``Delta_{i+1}(0)`` lies in the
+plane of ``(1, 1, 1)`` and ``(1, 0, 0)`` on the ``(1, 0, 0)`` side. Per component
+``rho_j = (Delta_j / t_{i+1}) / (D_j / t_i)`` and
+
+* ``0 < rho < 1``: ``k = c_low * rho`` (paper eq. 12: ``c > 0.8``, ``k < 1``);
+* ``rho >= 1``: ``k = max(1, c_high * rho)`` (eq. 13: ``c < 1``, ``k >= 1``);
+* ``rho <= 0`` (turns sharper than ``atan(sqrt2)``, outside the paper):
+  ``k = k_min * min(1, |Delta|/t_{i+1} / (|D|/t_i))``, i.e. ``k_min`` times the ratio of the
+  two average speeds when the next course is the slower one (else a tiny next course would
+  start with an unrepresentably fast approach).
+
+The end velocity of course ``i`` is ``-k_j D_j / t_i`` per component of ``S_i``.
+
+Defaults. ``c_low = 0.9``: inside the paper's range (0.8, 1); with ``c_low < 1`` a straight
+continuation arrives slower than the next course's average speed, which is eq. 14 (the
+next course then starts with ``gamma T > -1``). ``c_high = 0.95``: close to 1 so the transition
+speed is near the faster of the two averages, without reaching it. ``k_min = 0.25``: on sharp
+turns the component arrives at a quarter of the slower average speed instead of turning back.
+Eq. 14 itself needs the frame ``S_{i+1}``, which depends on the goal after next; the solver
+is total (it covers ``gamma T <= -1``), so eq. 14 is reported (:func:`condition_14`), not
+enforced.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from baselines.sgc.course import CourseProfile, HermiteProfile, HoldProfile
+
+__all__ = [
+    "C_HIGH",
+    "C_LOW",
+    "K_MIN",
+    "PAPER_MAX_TURN",
+    "EndVelocity",
+    "FrameCourse",
+    "choose_k",
+    "condition_14",
+    "course_end_velocity",
+    "normalized_frame",
+    "solve_course_in_frame",
+    "turn_angle",
+]
+
+C_LOW = 0.9
+C_HIGH = 0.95
+K_MIN = 0.25
+PAPER_MAX_TURN = math.pi / 6.0
+_SQ3 = 1.0 / math.sqrt(3.0)
+_SQ6 = 1.0 / math.sqrt(6.0)
+_SQ2 = 1.0 / math.sqrt(2.0)
+
+
+def _vec3(x, name: str) -> tuple[float, float, float]:
+    """Three Python floats (the hot path avoids numpy on 3-vectors); validates finiteness."""
+    try:
+        a0, a1, a2 = (x.tolist() if isinstance(x, np.ndarray) else x)
+        a0, a1, a2 = float(a0), float(a1), float(a2)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 3-vector, got {x!r}") from None
+    if not (math.isfinite(a0) and math.isfinite(a1) and math.isfinite(a2)):
+        raise ValueError(f"{name} contains NaN or inf: {x!r}")
+    return a0, a1, a2
+
+
+def _frame_rows(d, nxt):
+    """Rows of ``S_i`` (world unit vectors) from Python-float 3-tuples; None if ``d`` is 0."""
+    d0, d1, d2 = d
+    norm = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    if norm == 0.0:
+        return None
+    u0, u1, u2 = d0 / norm, d1 / norm, d2 / norm
+    e = None
+    if nxt is not None:
+        n0, n1, n2 = nxt
+        along = n0 * u0 + n1 * u1 + n2 * u2
+        p0, p1, p2 = n0 - along * u0, n1 - along * u1, n2 - along * u2
+        pn = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+        if pn > 1e-12 * math.sqrt(n0 * n0 + n1 * n1 + n2 * n2):
+            p0, p1, p2 = p0 / pn, p1 / pn, p2 / pn
+            along = p0 * u0 + p1 * u1 + p2 * u2  # second Gram-Schmidt pass: nearly parallel
+            p0, p1, p2 = p0 - along * u0, p1 - along * u1, p2 - along * u2
+            pn = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+            e = (p0 / pn, p1 / pn, p2 / pn)
+    if e is None:  # deterministic roll: cross with the world axis least aligned with d
+        a = (abs(u0), abs(u1), abs(u2))
+        j = a.index(min(a))
+        ax = [0.0, 0.0, 0.0]
+        ax[j] = 1.0
+        c0 = u1 * ax[2] - u2 * ax[1]
+        c1 = u2 * ax[0] - u0 * ax[2]
+        c2 = u0 * ax[1] - u1 * ax[0]
+        cn = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        e = (c0 / cn, c1 / cn, c2 / cn)
+    e0, e1, e2 = e
+    f0, f1, f2 = u1 * e2 - u2 * e1, u2 * e0 - u0 * e2, u0 * e1 - u1 * e0
+    # row j = N[j,0] d_hat + N[j,1] e + N[j,2] f with N's columns (1,1,1)/sqrt3,
+    # (2,-1,-1)/sqrt6, (0,1,-1)/sqrt2
+    a0, a1, a2 = _SQ3 * u0, _SQ3 * u1, _SQ3 * u2
+    b0, b1, b2 = _SQ6 * e0, _SQ6 * e1, _SQ6 * e2
+    c0, c1, c2 = _SQ2 * f0, _SQ2 * f1, _SQ2 * f2
+    return (
+        (a0 + 2.0 * b0, a1 + 2.0 * b1, a2 + 2.0 * b2),
+        (a0 - b0 + c0, a1 - b1 + c1, a2 - b2 + c2),
+        (a0 - b0 - c0, a1 - b1 - c1, a2 - b2 - c2),
+    ), norm
+
+
+def _mul(rows, v):
+    """``R @ v`` for rows and a vector given as tuples."""
+    v0, v1, v2 = v
+    return tuple(r[0] * v0 + r[1] * v1 + r[2] * v2 for r in rows)
+
+
+def _mul_t(rows, s):
+    """``R.T @ s``."""
+    s0, s1, s2 = s
+    r0, r1, r2 = rows
+    return (
+        r0[0] * s0 + r1[0] * s1 + r2[0] * s2,
+        r0[1] * s0 + r1[1] * s1 + r2[1] * s2,
+        r0[2] * s0 + r1[2] * s1 + r2[2] * s2,
+    )
+
+
+def normalized_frame(d_start, d_next=None) -> np.ndarray:
+    """Rotation matrix ``R`` of ``S_i``: ``R @ v`` are the components of world ``v`` in ``S_i``.
+
+    ``R @ d_start = |d_start|/sqrt3 (1, 1, 1)``; ``R @ d_next`` lies in the plane of
+    ``(1, 1, 1)`` and ``(1, 0, 0)`` with a non-negative ``(2, -1, -1)`` component. When
+    ``d_next`` is None, zero or parallel to ``d_start`` the roll about ``d_start`` is a fixed
+    deterministic choice. Raises ValueError if ``d_start`` is zero (a dwell has no frame).
+    """
+    d = _vec3(d_start, "d_start")
+    nxt = None if d_next is None else _vec3(d_next, "d_next")
+    out = _frame_rows(d, nxt)
+    if out is None:
+        raise ValueError("d_start is zero: a dwell course has no normalized frame")
+    return np.array(out[0])
+
+
+def turn_angle(d_start, d_next) -> float:
+    """Angle between ``D_i(0)`` and ``Delta_{i+1}(0)`` (0 if either is zero)."""
+    a0, a1, a2 = _vec3(d_start, "d_start")
+    b0, b1, b2 = _vec3(d_next, "d_next")
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), a0 * b0 + a1 * b1 + a2 * b2)
+
+
+def _k_rule(rho: float, c_low: float, c_high: float) -> float:
+    return max(1.0, c_high * rho) if rho >= 1.0 else c_low * rho
+
+
+def choose_k(
+    rho: np.ndarray, *, c_low: float = C_LOW, c_high: float = C_HIGH, k_min: float = K_MIN
+) -> np.ndarray:
+    """Per-component ``k`` from ``rho`` (eqs. 12-13); ``k_min`` where ``rho <= 0``.
+
+    :func:`course_end_velocity` passes ``k_min`` already scaled by the speed ratio.
+    """
+    rho = np.asarray(rho, dtype=float)
+    k = np.where(rho >= 1.0, np.maximum(1.0, c_high * rho), c_low * rho)
+    return np.where(rho > 0.0, k, k_min)
+
+
+class EndVelocity(NamedTuple):
+    """Diagnostics of :func:`course_end_velocity`.
+
+    ``rule``: ``"sgc"`` (eqs. 12-13), ``"last"`` (no next course: user or average velocity),
+    ``"rest"`` (arrive at rest: the next course is a dwell, or a zero end velocity was asked
+    for) or ``"dwell"`` (this course is one). ``within_paper_assumption`` is False when the
+    turn exceeds ``pi/6``, some ``rho <= 0``, or a user end velocity was clamped. ``frame``
+    is ``S_i`` (None for a dwell); ``rho`` is NaN where it is not defined.
+    """
+
+    velocity: np.ndarray
+    frame: np.ndarray | None
+    rho: np.ndarray
+    k: np.ndarray
+    turn_angle: float
+    within_paper_assumption: bool
+    rule: str
+
+
+_NAN3 = (math.nan, math.nan, math.nan)
+_ZERO3 = (0.0, 0.0, 0.0)
+
+
+def course_end_velocity(
+    d_start,
+    d_next,
+    t_course: float,
+    t_next: float | None,
+    *,
+    end_velocity=None,
+    c_low: float = C_LOW,
+    c_high: float = C_HIGH,
+    k_min: float = K_MIN,
+) -> tuple[np.ndarray, EndVelocity]:
+    """World end velocity ``D_i'(t_i)`` of course ``i`` and its diagnostics.
+
+    ``d_start = D_i(0)``, ``d_next = Delta_{i+1}(0)`` (None for the last goal),
+    ``t_course = t_i``, ``t_next = t_{i+1}``. Rules for what the paper does not cover:
+
+    * last goal (``d_next`` None): ``end_velocity`` if given, else the course's average
+      velocity ``-D_i(0)/t_i`` (``k = 1``); a zero ``end_velocity`` means arrive at rest;
+      components of a given end velocity that do not point at the goal (``k < k_min`` in
+      ``S_i``) are clamped to ``k_min``;
+    * ``d_next == 0`` (the next goal repeats the nail, a dwell): arrive at rest, velocity 0
+      (the course is then a :class:`HermiteProfile`, see :func:`solve_course_in_frame`);
+    * ``d_start == 0`` (this course is a dwell): velocity 0;
+    * ``rho <= 0`` (sharp turn): ``k = k_min * min(1, speed ratio of next to this course)``.
+
+    Plain-float arithmetic: this runs every control step of the expert.
+    """
+    d = _vec3(d_start, "d_start")
+    if not (math.isfinite(t_course) and t_course > 0.0):
+        raise ValueError(f"t_course must be finite and > 0, got {t_course!r}")
+    nxt = None if d_next is None else _vec3(d_next, "d_next")
+    if nxt is not None and nxt == _ZERO3:
+        nxt = "rest"
+    elif nxt is not None and (t_next is None or not (math.isfinite(t_next) and t_next > 0.0)):
+        raise ValueError(f"t_next must be finite and > 0, got {t_next!r}")
+    out = _frame_rows(d, nxt if isinstance(nxt, tuple) else None)
+    if out is None:
+        zeros = np.zeros(3)
+        return zeros, EndVelocity(zeros, None, np.full(3, np.nan), zeros, 0.0, True, "dwell")
+    rows, norm = out
+    dj = norm * _SQ3
+    avg = dj / t_course
+    angle = 0.0
+    if nxt is None:
+        if end_velocity is None:
+            v = np.array([-d[0] / t_course, -d[1] / t_course, -d[2] / t_course])
+            return v, EndVelocity(v, np.array(rows), np.full(3, np.nan), np.ones(3), 0.0, True,
+                                  "last")
+        ve = _vec3(end_velocity, "end_velocity")
+        if ve == _ZERO3:
+            nxt = "rest"
+        else:
+            ks = [-c / avg for c in _mul(rows, ve)]
+            rho = _NAN3
+            within = min(ks) >= k_min
+            rule = "last"
+    if nxt == "rest":
+        zeros = np.zeros(3)
+        return zeros, EndVelocity(zeros, np.array(rows), np.full(3, np.nan), zeros, 0.0, True,
+                                  "rest")
+    if nxt is not None:
+        rho = tuple(c / t_next / avg for c in _mul(rows, nxt))
+        n0, n1, n2 = nxt
+        speed_ratio = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) * t_course / (norm * t_next)
+        k_floor = k_min * min(1.0, speed_ratio)
+        ks = [_k_rule(r, c_low, c_high) if r > 0.0 else k_floor for r in rho]
+        angle = turn_angle(d, nxt)
+        within = angle <= PAPER_MAX_TURN + 1e-12 and min(rho) > 0.0
+        rule = "sgc"
+    else:
+        ks = [k if k >= k_min else k_min for k in ks]
+    v = np.array(_mul_t(rows, (-ks[0] * avg, -ks[1] * avg, -ks[2] * avg)))
+    return v, EndVelocity(v, np.array(rows), np.array(rho), np.array(ks), angle, within, rule)
+
+
+def condition_14(end_velocity, d_next, t_next: float, d_after=None) -> bool:
+    """Eq. 14: in ``S_{i+1}`` every component of the incoming velocity is slower than the
+    next course's average, ``-D'_{i+1,j}(0) < D_{i+1,j}(0) / t_{i+1}``."""
+    frame = normalized_frame(d_next, d_after)
+    v = frame @ np.asarray(end_velocity, float)
+    avg = float(np.linalg.norm(d_next)) * _SQ3 / t_next
+    return bool(np.all(-v < avg))
+
+
+class FrameCourse:
+    """Three component profiles of one course in its frame ``S_i``; evaluates in world."""
+
+    __slots__ = ("profiles", "duration", "_rows")
+
+    def __init__(self, frame, profiles: Sequence, duration: float) -> None:
+        """``frame``: ``S_i`` as a 3x3 array or as a tuple of three row tuples."""
+        rows = frame.tolist() if isinstance(frame, np.ndarray) else frame
+        self._rows = tuple(tuple(float(x) for x in r) for r in rows)
+        self.profiles = tuple(profiles)
+        self.duration = duration
+
+    @property
+    def frame(self) -> np.ndarray:
+        """``S_i`` as a rotation matrix (rows: the frame's axes in world)."""
+        return np.array(self._rows)
+
+    def state(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World ``(D, D', D'')`` at scalar ``t`` seconds from the course start."""
+        p0, p1, p2 = self.profiles
+        s0, s1, s2 = p0.state(t), p1.state(t), p2.state(t)
+        rows = self._rows
+        return (
+            np.array(_mul_t(rows, (s0[0], s1[0], s2[0]))),
+            np.array(_mul_t(rows, (s0[1], s1[1], s2[1]))),
+            np.array(_mul_t(rows, (s0[2], s1[2], s2[2]))),
+        )
+
+    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """World ``(D, D', D'')`` at an array of times: each of shape ``t.shape + (3,)``."""
+        parts = [p.evaluate(t) for p in self.profiles]
+        out = []
+        for q in range(3):
+            comps = np.stack([np.asarray(parts[j][q], float) for j in range(3)], axis=-1)
+            out.append(comps @ self.frame)
+        return out[0], out[1], out[2]
+
+    @property
+    def branches(self) -> tuple[str, ...]:
+        return tuple(p.branch for p in self.profiles)
+
+    @property
+    def k(self) -> np.ndarray:
+        return np.array([getattr(p, "k", np.nan) for p in self.profiles])
+
+
+_IDENTITY_ROWS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def solve_course_in_frame(
+    frame: np.ndarray | None, deviation_now, velocity_now, time_left: float, end_velocity
+) -> FrameCourse:
+    """Solve the rest of a course from the current state (what a stateless expert calls).
+
+    Per component ``j`` of ``S_i``: ``k'_j = -v_end_j T_left / D_j(now)``. Re-solving from a
+    state on the plan returns the plan (time consistency). Components that cannot use SGC get
+    a :class:`HermiteProfile` to ``(0, v_end_j)``: an end velocity of zero (arrive at rest),
+    ``D_j(now) == 0``, or ``k'_j <= 0`` (only after a disturbance: the end velocity points
+    away from the goal as seen from the current deviation), or ``gamma T - log k'`` outside the
+    representable range of :meth:`CourseProfile.solve` (a deviation that is tiny next to the
+    speed, e.g. 1e-30 m approached at 1 m/s). ``k'`` is not clamped to
+    ``k_min`` here: that would break time consistency (``k_min`` applies at course start).
+    A zero deviation, velocity and end velocity gives the dwell (:class:`HoldProfile`).
+    ``frame`` None means the world frame.
+    """
+    if not (math.isfinite(time_left) and time_left > 0.0):
+        raise ValueError(f"time_left must be finite and > 0, got {time_left!r}")
+    if frame is None:
+        rows = _IDENTITY_ROWS
+    else:
+        rows = tuple(tuple(r) for r in (frame.tolist() if isinstance(frame, np.ndarray) else frame))
+    d = _mul(rows, _vec3(deviation_now, "deviation_now"))
+    v = _mul(rows, _vec3(velocity_now, "velocity_now"))
+    ve = _mul(rows, _vec3(end_velocity, "end_velocity"))
+    rest = ve == _ZERO3
+    if rest and d == _ZERO3 and v == _ZERO3:
+        hold = HoldProfile(time_left)
+        return FrameCourse(rows, (hold, hold, hold), time_left)
+    profiles = []
+    for dj, vj, vej in zip(d, v, ve, strict=True):
+        k = -vej * time_left / dj if dj != 0.0 else 0.0
+        if rest or k <= 0.0:
+            profiles.append(HermiteProfile(dj, vj, time_left, vej))
+            continue
+        try:
+            profiles.append(CourseProfile.solve(dj, vj, time_left, k))
+        except ValueError:  # gamma T - log k out of the representable range
+            profiles.append(HermiteProfile(dj, vj, time_left, vej))
+    return FrameCourse(rows, profiles, time_left)

@@ -1,0 +1,149 @@
+"""Orientation deviations as rotation vectors (world frame), somersaults and Jacobians.
+
+Convention (design.md): ``R_current = Exp(phi) R_goal``, so ``phi = Log(R_current R_goal^T)``
+unwrapped to stay continuous; a somersault's ``phi`` may be longer than ``pi``. With ``R_goal``
+fixed, ``Rdot R^T = [J_l(phi) phi_dot]x``, so the world angular velocity is
+``omega = J_l(phi) phi_dot`` with the left Jacobian of SO(3)
+
+    J_l(phi) = I + A(theta) [phi]x + B(theta) [phi]x^2,
+    A = (1 - cos theta) / theta^2,  B = (theta - sin theta) / theta^3,  theta = |phi|,
+
+and ``omega_dot = J_l phi_ddot + (d/dt J_l) phi_dot``. ``J_l`` is singular where
+``theta = 2 pi n`` (n >= 1); :func:`left_jacobian_inverse` raises there.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+__all__ = [
+    "angular_acceleration",
+    "angular_velocity",
+    "left_jacobian",
+    "left_jacobian_inverse",
+    "orientation_deviation",
+    "quat_to_rotvec",
+    "rotvec_to_quat",
+    "unwrap_rotvec",
+]
+
+_TWO_PI = 2.0 * math.pi
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    x, y, z = v
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _coefficients(theta: float) -> tuple[float, float, float, float]:
+    """``A, B`` and ``A'/theta, B'/theta`` (Taylor series below 0.05 against cancellation)."""
+    if theta < 0.05:
+        t2 = theta * theta
+        t4 = t2 * t2
+        t6 = t4 * t2
+        return (
+            0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0 + t4 * t4 / 3628800.0,
+            1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0 + t4 * t4 / 39916800.0,
+            -1.0 / 12.0 + t2 / 180.0 - t4 / 6720.0 + t6 / 453600.0,
+            -1.0 / 60.0 + t2 / 1260.0 - t4 / 60480.0 + t6 / 4989600.0,
+        )
+    s = math.sin(theta)
+    one_minus_c = 2.0 * math.sin(0.5 * theta) ** 2
+    t2 = theta * theta
+    a = one_minus_c / t2
+    b = (theta - s) / (t2 * theta)
+    da = (theta * s - 2.0 * one_minus_c) / (t2 * t2)
+    db = (one_minus_c * theta - 3.0 * (theta - s)) / (t2 * t2 * theta)
+    return a, b, da, db
+
+
+def left_jacobian(phi) -> np.ndarray:
+    """``J_l(phi)``: ``omega = J_l(phi) phi_dot`` for ``R = Exp(phi) R_goal``."""
+    phi = np.asarray(phi, dtype=float)
+    a, b, _, _ = _coefficients(float(np.linalg.norm(phi)))
+    k = _skew(phi)
+    return np.eye(3) + a * k + b * (k @ k)
+
+
+def left_jacobian_inverse(phi) -> np.ndarray:
+    """``J_l(phi)^-1 = I - [phi]x / 2 + (1/theta^2 - (1 + cos)/(2 theta sin)) [phi]x^2``.
+
+    Raises ValueError within 1e-9 rad of ``theta = 2 pi n`` where ``J_l`` is singular.
+    """
+    phi = np.asarray(phi, dtype=float)
+    theta = float(np.linalg.norm(phi))
+    k = _skew(phi)
+    if theta < 0.05:
+        t2 = theta * theta
+        e = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+    else:
+        n = round(theta / _TWO_PI)
+        if n >= 1 and abs(theta - n * _TWO_PI) < 1e-9:
+            raise ValueError(
+                f"phi has length {theta!r} = 2*pi*{n}: the left Jacobian is singular there"
+            )
+        e = 1.0 / (theta * theta) - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
+    return np.eye(3) - 0.5 * k + e * (k @ k)
+
+
+def angular_velocity(phi, phi_dot) -> np.ndarray:
+    """World angular velocity ``J_l(phi) phi_dot``."""
+    return left_jacobian(phi) @ np.asarray(phi_dot, dtype=float)
+
+
+def angular_acceleration(phi, phi_dot, phi_ddot) -> np.ndarray:
+    """``omega_dot = J_l phi_ddot + (d/dt J_l) phi_dot``.
+
+    ``(d/dt J_l) phi_dot = (A'/theta)(phi.phi_dot)(phi x phi_dot)
+    + (B'/theta)(phi.phi_dot)(phi x (phi x phi_dot)) + B phi_dot x (phi x phi_dot)``
+    (the ``[phi_dot]x phi_dot`` term vanishes).
+    """
+    phi = np.asarray(phi, dtype=float)
+    pd = np.asarray(phi_dot, dtype=float)
+    pdd = np.asarray(phi_ddot, dtype=float)
+    a, b, da, db = _coefficients(float(np.linalg.norm(phi)))
+    k = _skew(phi)
+    j = np.eye(3) + a * k + b * (k @ k)
+    dot = float(phi @ pd)
+    c1 = np.cross(phi, pd)
+    return j @ pdd + da * dot * c1 + db * dot * np.cross(phi, c1) + b * np.cross(pd, c1)
+
+
+def rotvec_to_quat(phi) -> np.ndarray:
+    """Quaternion ``(x, y, z, w)`` of the rotation vector ``phi`` (any length)."""
+    return Rotation.from_rotvec(np.asarray(phi, dtype=float)).as_quat()
+
+
+def quat_to_rotvec(quat) -> np.ndarray:
+    """Principal rotation vector (``|phi| <= pi``) of a quaternion ``(x, y, z, w)``."""
+    return Rotation.from_quat(np.asarray(quat, dtype=float)).as_rotvec()
+
+
+def unwrap_rotvec(phi_new, phi_prev) -> np.ndarray:
+    """The representative ``phi_new + 2 pi n axis`` of the same rotation closest to ``phi_prev``.
+
+    Keeps a tracked deviation continuous through ``|phi| = pi`` (somersaults). For the identity
+    the axis is taken from ``phi_prev``.
+    """
+    phi_new = np.asarray(phi_new, dtype=float)
+    prev = np.asarray(phi_prev, dtype=float)
+    theta = float(np.linalg.norm(phi_new))
+    if theta < 1e-12:
+        pn = float(np.linalg.norm(prev))
+        if pn == 0.0:
+            return phi_new.copy()
+        n = round(pn / _TWO_PI)
+        return phi_new + (n * _TWO_PI / pn) * prev
+    axis = phi_new / theta
+    n = round((float(axis @ prev) - theta) / _TWO_PI)
+    # the same rotation is also -axis (2 pi - theta): both families are theta + 2 pi n on axis
+    return axis * (theta + n * _TWO_PI)
+
+
+def orientation_deviation(current: Rotation, goal: Rotation, phi_prev=None) -> np.ndarray:
+    """``phi = Log(R_current R_goal^T)``, unwrapped against ``phi_prev`` when given."""
+    phi = (current * goal.inv()).as_rotvec()
+    return phi if phi_prev is None else unwrap_rotvec(phi, phi_prev)
