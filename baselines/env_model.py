@@ -1,0 +1,96 @@
+"""What a model-based policy knows about an environment besides its observations.
+
+Masses, inertias, action limits, gravity and the integrator's step are fixed by the scenario
+and the env's construction; they are not in the observation because they never change within
+an episode. A policy built from an :class:`EnvModel` stays a function of the observation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from sgc_env.observation import ObservationLayout
+
+__all__ = ["BodyModel", "EnvModel"]
+
+
+@dataclass(frozen=True)
+class BodyModel:
+    """Rigid-body constants of one driven body."""
+
+    mass: float
+    inertia: tuple[float, float, float]
+    force_limit: float
+    torque_limit: float
+
+
+@dataclass(frozen=True)
+class EnvModel:
+    """Static description of an SGC environment: enough to turn wrenches into actions."""
+
+    layout: ObservationLayout
+    bodies: tuple[BodyModel, ...]
+    gravity: tuple[float, float, float]
+    sim_dt: float
+    substeps: int
+    use_torque: bool
+
+    @property
+    def control_dt(self) -> float:
+        return self.sim_dt * self.substeps
+
+    @classmethod
+    def from_env(cls, env: Any) -> EnvModel:
+        """Read the model of a Gymnasium env (wrapped or not) or of a vector env's first env."""
+        base = _unwrap(env)
+        scenario = base.scenario
+        bodies = tuple(
+            BodyModel(
+                mass=float(b.mass),
+                inertia=tuple(float(x) for x in inertia),  # type: ignore[arg-type]
+                force_limit=float(b.force_limit),
+                torque_limit=float(b.torque_limit),
+            )
+            for b, inertia in zip(scenario.bodies, base.body_inertia, strict=True)
+        )
+        return cls(
+            layout=base.layout,
+            bodies=bodies,
+            gravity=tuple(float(g) for g in scenario.gravity),  # type: ignore[arg-type]
+            sim_dt=1.0 / float(base.sim_frequency),
+            substeps=int(base.substeps),
+            use_torque=bool(base.use_torque),
+        )
+
+    def action_from_wrenches(self, forces: np.ndarray, torques: np.ndarray) -> np.ndarray:
+        """Normalised, clipped action from world forces (N) and torques (N m).
+
+        The action is float64 on purpose: rounding it to the float32 of the action space moves
+        a thin rod's orientation at a goal by up to ~1e-9 rad (its axial inertia amplifies the
+        rounding of the world torque), and the env uses whatever precision it is given.
+        """
+        n = len(self.bodies)
+        f_lim = np.array([b.force_limit for b in self.bodies])[:, None]
+        scaled_f = np.asarray(forces, dtype=float).reshape(n, 3) / f_lim
+        if self.use_torque:
+            t_lim = np.array([b.torque_limit for b in self.bodies])[:, None]
+            scaled_t = np.asarray(torques, dtype=float).reshape(n, 3) / t_lim
+            scaled = np.concatenate([scaled_f, scaled_t], axis=1)
+        else:
+            scaled = scaled_f
+        return np.clip(scaled.reshape(-1), -1.0, 1.0)
+
+
+def _unwrap(env: Any) -> Any:
+    """The base SGC env behind wrappers, or behind the first sub-env of a vector env."""
+    if hasattr(env, "get_attr") and not hasattr(env, "unwrapped"):
+        return env.get_attr("unwrapped", [0])[0]
+    if hasattr(env, "envs"):
+        return env.envs[0].unwrapped
+    base = env.unwrapped
+    if not hasattr(base, "scenario"):
+        raise TypeError(f"{type(base).__name__} is not an SGC environment (no scenario)")
+    return base

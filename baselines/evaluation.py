@@ -1,0 +1,389 @@
+"""One evaluation harness for every policy: seeded episodes, per-goal rows, a scorecard.
+
+``evaluate(policy, env_id, episodes, seed)`` runs episode k with ``reset(seed=seed + k)``,
+keeps the reset info and every step's info, scores each episode with
+:func:`sgc_env.metrics.score_episode` against :func:`goals_from_scenario` of the scenario the
+episode actually ran, and aggregates. It imports neither torch nor SB3 (only a model path
+spec does, through :func:`baselines.policies.make_policy`), so a training callback can call
+it with the model object itself on held-out seeds.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+import sgc_env
+from baselines.policies import make_policy, policy_label
+from sgc_env.metrics import GoalSpec, Tolerances, goals_from_scenario, score_episode
+
+__all__ = [
+    "GOAL_COLUMNS",
+    "SUMMARY_KEYS",
+    "EpisodeRecord",
+    "EvaluationResult",
+    "evaluate",
+    "goal_rows",
+    "json_ready",
+    "run_episode",
+    "summarize",
+    "write_goals_csv",
+    "write_summary_json",
+]
+
+GOAL_COLUMNS: tuple[str, ...] = (
+    "env_id", "policy", "episode", "seed", "body", "goal", "time",
+    "position_error", "orientation_error", "closest_approach_offset", "entry_offset",
+    "position_closest_offset", "orientation_closest_offset", "position_entry_offset",
+    "orientation_entry_offset", "closest_distance", "closest_angle", "speed",
+    "goal_speed_ratio", "velocity_jump", "angular_velocity_jump", "success",
+)  # fmt: skip
+
+#: Keys of the summary scorecard, grouped as in docs/evaluation.md.
+SUMMARY_KEYS: tuple[str, ...] = (
+    "env_id", "policy", "episodes", "seed", "steps", "wall_time_s", "return_mean",
+    "terminated", "n_goals", "goals_met", "goals_after_end", "success_rate",
+    "position_error_max", "position_error_mean", "orientation_error_max",
+    "orientation_error_mean",
+    "position_closest_offset_abs_max", "orientation_closest_offset_abs_max",
+    "position_entry_offset_abs_max", "orientation_entry_offset_abs_max",
+    "sparc_mean", "sparc_track_mean", "ldlj_mean", "angular_sparc_mean", "velocity_jump_max",
+    "angular_velocity_jump_max", "speed_minima_mean", "goal_speed_ratio_min",
+    "rotation_ratio_max", "rotation_excess_mean",
+    "force_sq_integral_mean", "torque_sq_integral_mean", "force_peak_max", "torque_peak_max",
+)  # fmt: skip
+
+PolicyLike = Any
+
+
+@dataclass
+class EpisodeRecord:
+    """One scored episode. ``infos`` (and ``initial_info``) are kept only when asked."""
+
+    episode: int
+    seed: int
+    steps: int
+    episode_return: float
+    terminated: bool
+    card: dict[str, Any]
+    goals: list[list[GoalSpec]]
+    dt: float
+    wall_time_s: float
+    infos: list[dict[str, Any]] | None = None
+    initial_info: dict[str, Any] | None = None
+
+
+@dataclass
+class EvaluationResult:
+    """All episodes of one policy on one env: per-goal ``rows`` and the ``summary`` card."""
+
+    env_id: str
+    policy: str
+    seed: int
+    episodes: list[EpisodeRecord]
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    summary: dict[str, Any] = field(default_factory=dict)
+
+
+def _finite(values: Iterable[Any]) -> np.ndarray:
+    arr = np.array([np.nan if v is None else float(v) for v in values], dtype=float)
+    return arr[np.isfinite(arr)]
+
+
+def _max(values: Iterable[Any]) -> float:
+    arr = _finite(values)
+    return float(arr.max()) if arr.size else math.nan
+
+
+def _min(values: Iterable[Any]) -> float:
+    arr = _finite(values)
+    return float(arr.min()) if arr.size else math.nan
+
+
+def _mean(values: Iterable[Any]) -> float:
+    arr = _finite(values)
+    return float(arr.mean()) if arr.size else math.nan
+
+
+def _first_finite(*values: Any) -> float:
+    for v in values:
+        if v is not None and math.isfinite(v):
+            return float(v)
+    return math.nan
+
+
+def run_episode(
+    policy: PolicyLike,
+    env: gym.Env,
+    seed: int,
+    *,
+    episode: int = 0,
+    tolerances: Tolerances | None = None,
+    keep_infos: bool = False,
+    max_steps: int = 100_000,
+    frames: list[np.ndarray] | None = None,
+) -> EpisodeRecord:
+    """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
+
+    ``frames``: a list to append ``env.render()`` to after the reset and every step (for
+    videos; the env needs ``render_mode="rgb_array"``).
+    """
+    started = time.perf_counter()
+    obs, initial_info = env.reset(seed=seed)
+    if frames is not None:
+        frames.append(env.render())
+    infos: list[dict[str, Any]] = []
+    state, total, terminated = None, 0.0, False
+    first = True
+    for _ in range(max_steps):
+        action, state = policy.predict(
+            obs, state=state, episode_start=np.array([first]), deterministic=True
+        )
+        first = False
+        obs, reward, terminated, truncated, info = env.step(action)
+        infos.append(info)
+        total += float(reward)
+        if frames is not None:
+            frames.append(env.render())
+        if terminated or truncated:
+            break
+    base = env.unwrapped
+    goals = goals_from_scenario(base.scenario)
+    card = score_episode(infos, goals, base.dt, tolerances, initial_info=initial_info)
+    return EpisodeRecord(
+        episode=episode,
+        seed=seed,
+        steps=len(infos),
+        episode_return=total,
+        terminated=bool(terminated),
+        card=card,
+        goals=goals,
+        dt=float(base.dt),
+        wall_time_s=time.perf_counter() - started,
+        infos=infos if keep_infos else None,
+        initial_info=initial_info if keep_infos else None,
+    )
+
+
+def goal_rows(record: EpisodeRecord, env_id: str, policy: str) -> list[dict[str, Any]]:
+    """One row per goal of every body (columns :data:`GOAL_COLUMNS`; None where n/a).
+
+    A goal with a nail and an orientation is one row; ``closest_approach_offset`` and
+    ``entry_offset`` (s, signed, positive = late) are the position track's where the goal
+    has a nail, else the orientation track's.
+    """
+    rows = []
+    for b, (body_goals, card) in enumerate(zip(record.goals, record.card["bodies"], strict=True)):
+        if card is None:
+            continue
+        pos = iter(card["position_goals"])
+        ori = iter(card["orientation_goals"])
+        for j, goal in enumerate(body_goals):
+            p = next(pos) if goal.nail is not None else {}
+            o = next(ori) if goal.orientation is not None else {}
+            rows.append(
+                {
+                    "env_id": env_id,
+                    "policy": policy,
+                    "episode": record.episode,
+                    "seed": record.seed,
+                    "body": b,
+                    "goal": j,
+                    "time": goal.time,
+                    "position_error": p.get("position_error"),
+                    "orientation_error": o.get("orientation_error"),
+                    "closest_approach_offset": _first_finite(
+                        p.get("closest_offset"), o.get("closest_offset")
+                    ),
+                    "entry_offset": _first_finite(p.get("entry_offset"), o.get("entry_offset")),
+                    "position_closest_offset": p.get("closest_offset"),
+                    "orientation_closest_offset": o.get("closest_offset"),
+                    "position_entry_offset": p.get("entry_offset"),
+                    "orientation_entry_offset": o.get("entry_offset"),
+                    "closest_distance": p.get("closest_distance"),
+                    "closest_angle": o.get("closest_angle"),
+                    "speed": p.get("speed"),
+                    "goal_speed_ratio": p.get("goal_speed_ratio"),
+                    "velocity_jump": p.get("velocity_jump"),
+                    "angular_velocity_jump": o.get("angular_velocity_jump"),
+                    "success": bool(card["met"][j]),
+                }
+            )
+    return rows
+
+
+def summarize(
+    records: Sequence[EpisodeRecord], rows: Sequence[Mapping[str, Any]]
+) -> dict[str, Any]:
+    """Scorecard over episodes: maxima of errors, offsets and jumps, means of the rest."""
+    cards = [r.card for r in records]
+    bodies = [b for c in cards for b in c["bodies"] if b is not None]
+    n_goals = sum(c["n_goals"] for c in cards)
+    met = sum(c["goals_met"] for c in cards)
+
+    def column(key: str) -> list[Any]:
+        return [row[key] for row in rows]
+
+    return {
+        "episodes": len(records),
+        "steps": sum(r.steps for r in records),
+        "wall_time_s": sum(r.wall_time_s for r in records),
+        "return_mean": _mean(r.episode_return for r in records),
+        "terminated": sum(r.terminated for r in records),
+        "n_goals": n_goals,
+        "goals_met": met,
+        "goals_after_end": sum(c["goals_after_end"] for c in cards),
+        "success_rate": met / n_goals if n_goals else math.nan,
+        "position_error_max": _max(column("position_error")),
+        "position_error_mean": _mean(column("position_error")),
+        "orientation_error_max": _max(column("orientation_error")),
+        "orientation_error_mean": _mean(column("orientation_error")),
+        "position_closest_offset_abs_max": _max(
+            abs(v) for v in _finite(column("position_closest_offset"))
+        ),
+        "orientation_closest_offset_abs_max": _max(
+            abs(v) for v in _finite(column("orientation_closest_offset"))
+        ),
+        "position_entry_offset_abs_max": _max(
+            abs(v) for v in _finite(column("position_entry_offset"))
+        ),
+        "orientation_entry_offset_abs_max": _max(
+            abs(v) for v in _finite(column("orientation_entry_offset"))
+        ),
+        "sparc_mean": _mean(c["sparc_mean"] for c in cards),
+        "sparc_track_mean": _mean(c["sparc_track_mean"] for c in cards),
+        "ldlj_mean": _mean(c["ldlj_mean"] for c in cards),
+        "angular_sparc_mean": _mean(c["angular_sparc_mean"] for c in cards),
+        "velocity_jump_max": _max(c["velocity_jump_max"] for c in cards),
+        "angular_velocity_jump_max": _max(c["angular_velocity_jump_max"] for c in cards),
+        "speed_minima_mean": _mean(c["speed_minima_total"] for c in cards),
+        "goal_speed_ratio_min": _min(b["goal_speed_ratio_min"] for b in bodies),
+        "rotation_ratio_max": _max(c["rotation_ratio_max"] for c in cards),
+        "rotation_excess_mean": _mean(c["rotation_excess_total"] for c in cards),
+        "force_sq_integral_mean": _mean(c["force_sq_integral"] for c in cards),
+        "torque_sq_integral_mean": _mean(c["torque_sq_integral"] for c in cards),
+        "force_peak_max": _max(c["force_peak"] for c in cards),
+        "torque_peak_max": _max(c["torque_peak"] for c in cards),
+    }
+
+
+def _check_env_id(env_id: str) -> None:
+    if not isinstance(env_id, str) or env_id not in gym.registry:
+        raise ValueError(
+            f"env_id: unknown environment {env_id!r}; SGC ids: {list(sgc_env.ENV_IDS)}"
+        )
+
+
+def _resolve_policy(
+    policy: PolicyLike | str | Callable[[gym.Env], PolicyLike], env: gym.Env, seed: int
+) -> tuple[PolicyLike, str]:
+    if isinstance(policy, str):
+        return make_policy(policy, env, seed=seed), policy_label(policy)
+    if isinstance(policy, type) or (callable(policy) and not hasattr(policy, "predict")):
+        built = policy(env)
+        return built, type(built).__name__
+    if not hasattr(policy, "predict"):
+        raise ValueError(
+            f"policy must be a spec string, an object with .predict or a factory of one, "
+            f"got {type(policy).__name__}"
+        )
+    return policy, type(policy).__name__
+
+
+def evaluate(
+    policy: PolicyLike | str | Callable[[gym.Env], PolicyLike],
+    env_id: str,
+    episodes: int,
+    seed: int,
+    env_kwargs: Mapping[str, Any] | None = None,
+    tolerances: Tolerances | None = None,
+    *,
+    label: str | None = None,
+    keep_infos: int = 1,
+) -> EvaluationResult:
+    """Run ``episodes`` seeded episodes (episode k: ``reset(seed=seed + k)``) and score them.
+
+    ``policy``: a spec for :func:`make_policy` (``"expert"``, ``"random"``, a model path...),
+    an object with an SB3-style ``predict`` (e.g. a model being trained), or a class or
+    factory called with the env (for policies that read the env, such as
+    :class:`~baselines.MinimumJerkController`). ``keep_infos``: how many leading episodes
+    keep their infos for plots. The env is created here and closed at the end.
+    """
+    _check_env_id(env_id)
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise ValueError(f"seed must be an integer, got {seed!r}")
+    env = gym.make(env_id, **dict(env_kwargs or {}))
+    try:
+        if not hasattr(env.unwrapped, "scenario"):
+            raise ValueError(f"env_id: {env_id!r} is not an SGC environment (no scenario)")
+        agent, default_label = _resolve_policy(policy, env, int(seed))
+        name = label or default_label
+        records = [
+            run_episode(
+                agent,
+                env,
+                int(seed) + k,
+                episode=k,
+                tolerances=tolerances,
+                keep_infos=k < keep_infos,
+            )  # fmt: skip
+            for k in range(episodes)
+        ]
+    finally:
+        env.close()
+    rows = [row for r in records for row in goal_rows(r, env_id, name)]
+    summary = {"env_id": env_id, "policy": name, "seed": int(seed), **summarize(records, rows)}
+    return EvaluationResult(env_id, name, int(seed), records, rows, summary)
+
+
+def json_ready(value: Any) -> Any:
+    """Nested value with numpy scalars as Python numbers and non-finite floats as None."""
+    if isinstance(value, Mapping):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_ready(value.tolist())
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def _cell(value: Any) -> Any:
+    ready = json_ready(value)
+    return "" if ready is None else ready
+
+
+def write_goals_csv(rows: Sequence[Mapping[str, Any]], path: str | Path) -> Path:
+    """Per-goal rows as CSV (columns :data:`GOAL_COLUMNS`; empty cells for None / nan)."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with out.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(GOAL_COLUMNS), extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _cell(row.get(k)) for k in GOAL_COLUMNS})
+    return out
+
+
+def write_summary_json(summary: Mapping[str, Any], path: str | Path) -> Path:
+    """The scorecard as strict JSON (nan and inf become null)."""
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(json_ready(summary), indent=2, allow_nan=False) + "\n")
+    return out

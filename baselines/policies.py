@@ -1,0 +1,171 @@
+"""One way to name a policy: ``make_policy(spec, env)`` for the CLI and the evaluation harness.
+
+Specs: ``expert``, ``dynamic-constraints``, ``minimum-jerk``, ``random``, or the path of a
+Stable-Baselines3 model ``.zip`` (PPO, SAC, TD3, A2C, DDPG; the algorithm is read from the
+saved data, SB3 and torch are imported only then). Every policy has the SB3 signature
+``predict(observation, state=None, episode_start=None, deterministic=True)``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from baselines.comparison_policies import (
+    DynamicConstraintsController,
+    MinimumJerkController,
+    episode_model,
+    new_episode_flags,
+    observation_tick,
+)
+from baselines.expert import SGCExpert
+
+__all__ = [
+    "BUILTIN_POLICIES",
+    "EpisodeExpert",
+    "RandomPolicy",
+    "algorithm_from_data",
+    "load_sb3_model",
+    "make_policy",
+    "policy_label",
+]
+
+BUILTIN_POLICIES: tuple[str, ...] = ("expert", "dynamic-constraints", "minimum-jerk", "random")
+SB3_ALGORITHMS: tuple[str, ...] = ("PPO", "SAC", "TD3", "A2C", "DDPG")
+
+
+class RandomPolicy:
+    """Uniform actions from a private, seeded copy of the action space (reproducible)."""
+
+    def __init__(self, action_space: gym.spaces.Space, seed: int | None = None) -> None:
+        if not isinstance(action_space, gym.spaces.Box):
+            raise ValueError(f"action_space must be a Box, got {type(action_space).__name__}")
+        self.action_space = gym.spaces.Box(
+            action_space.low, action_space.high, action_space.shape, action_space.dtype, seed=seed
+        )
+
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """A sample per observation (a batch gets one row each)."""
+        obs = observation["observation"] if isinstance(observation, dict) else observation
+        obs = np.asarray(obs)
+        if obs.ndim >= 2:
+            return np.stack([self.action_space.sample() for _ in range(obs.shape[0])]), state
+        return self.action_space.sample(), state
+
+
+class EpisodeExpert:
+    """:class:`SGCExpert` with its env model re-read at every episode start, per sub-env.
+
+    The expert reads masses and force limits once, at construction; random-scenario envs
+    redraw them on every reset, so a stale model under- or over-drives the body. This wrapper
+    keeps one expert per sub-env and rebuilds it when an episode starts (``episode_start``
+    or an observation at tick 0).
+    """
+
+    def __init__(self, env: Any) -> None:
+        self.env = env
+        self._probe = episode_model(env, 0)
+        self._experts: dict[int, SGCExpert] = {}
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        obs = np.asarray(observation)
+        batch = obs.ndim == 2
+        rows = obs if batch else obs[None]
+        starts = new_episode_flags(episode_start, rows.shape[0])
+        actions = []
+        for i, (row, start) in enumerate(zip(rows, starts, strict=True)):
+            if start or i not in self._experts or observation_tick(self._probe, row) == 0:
+                self._experts[i] = SGCExpert(model=episode_model(self.env, i))
+            actions.append(self._experts[i].action(row))
+        return (np.stack(actions) if batch else actions[0]), state
+
+
+def policy_label(spec: str) -> str:
+    """Short name for output folders and tables: the spec, or a model file's stem."""
+    return spec if spec in BUILTIN_POLICIES else Path(spec).stem
+
+
+def algorithm_from_data(data: dict[str, Any]) -> str:
+    """SB3 algorithm name of a saved model, from the data dict of its zip.
+
+    The policy class's module tells SAC (``sac.policies``) and TD3/DDPG (``td3.policies``)
+    apart from on-policy models (``common.policies``); DDPG is TD3 with ``policy_delay`` 1
+    and no target noise clip, PPO has a ``clip_range`` that A2C lacks.
+    """
+    policy_class = data.get("policy_class")
+    if policy_class is None:
+        raise ValueError("model data has no policy_class: not a Stable-Baselines3 model")
+    module = getattr(policy_class, "__module__", None)
+    if module is None and isinstance(policy_class, dict):
+        module = policy_class.get("__module__", "")
+    module = str(module)
+    if ".sac." in module:
+        return "SAC"
+    if ".td3." in module:
+        ddpg = data.get("policy_delay") == 1 and data.get("target_noise_clip") == 0.0
+        return "DDPG" if ddpg else "TD3"
+    if ".ppo." in module or "clip_range" in data:
+        return "PPO"
+    if ".a2c." in module or ".common." in module:
+        return "A2C"
+    raise ValueError(f"cannot tell the algorithm of a model with policy class from {module!r}")
+
+
+def load_sb3_model(path: str | Path) -> Any:
+    """Load a Stable-Baselines3 model zip on the CPU, detecting its algorithm."""
+    file = Path(path)
+    if not file.is_file():
+        raise ValueError(f"policy: model file {str(path)!r} does not exist")
+    from stable_baselines3.common.save_util import load_from_zip_file
+
+    data, _, _ = load_from_zip_file(file, load_data=True, device="cpu")
+    if data is None:
+        raise ValueError(f"policy: {str(path)!r} holds no model data")
+    name = algorithm_from_data(data)
+    algorithm = getattr(importlib.import_module("stable_baselines3"), name)
+    return algorithm.load(file, device="cpu")
+
+
+def _needs_flat_observation(env: Any, spec: str) -> None:
+    if not isinstance(env.observation_space, gym.spaces.Box):
+        raise ValueError(
+            f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
+            f"{type(env.observation_space).__name__}"
+        )
+
+
+def make_policy(spec: str, env: Any, seed: int | None = None) -> Any:
+    """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``."""
+    if not isinstance(spec, str) or not spec:
+        raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
+    if spec == "random":
+        return RandomPolicy(env.action_space, seed)
+    if spec in ("expert", "dynamic-constraints", "minimum-jerk"):
+        _needs_flat_observation(env, spec)
+        if spec == "expert":
+            return EpisodeExpert(env)
+        if spec == "dynamic-constraints":
+            return DynamicConstraintsController(env)
+        return MinimumJerkController(env)
+    if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
+        return load_sb3_model(spec)
+    raise ValueError(
+        f"policy: unknown spec {spec!r}; expected one of {list(BUILTIN_POLICIES)} or the path "
+        "of a Stable-Baselines3 model .zip"
+    )

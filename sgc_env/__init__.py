@@ -1,0 +1,36 @@
+"""sgc_env: Gymnasium environments for sequential-goal constraints (Liu, Ko & Chang 1993).
+
+Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+
+from sgc_env.observation import ObservationLayout
+from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_scenario
+
+__all__ = [
+    "ENV_IDS",
+    "Body",
+    "Goal",
+    "ObservationLayout",
+    "Prop",
+    "Scenario",
+    "ScenarioError",
+    "load_scenario",
+]
+
+_ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
+_REGISTRY: dict[str, tuple[str, dict]] = {
+    "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
+    "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
+    "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
+    "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
+    "SGCPointGoal-v0": ("sgc_env.envs.goal_env:SGCGoalEnv", {"random_scenario": "point"}),
+}
+ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
+
+for _id, (_entry, _kwargs) in _REGISTRY.items():
+    if _id not in gym.registry:
+        gym.register(id=_id, entry_point=_entry, kwargs=_kwargs)

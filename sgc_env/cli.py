@@ -1,0 +1,43 @@
+"""The ``sgc`` console command: one subcommand per module in :mod:`sgc_env.commands`.
+
+Each command module exposes ``add_arguments(parser)`` and ``run(args) -> int``; heavy imports
+(PyBullet, torch) happen inside ``run`` so that ``sgc --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+from collections.abc import Sequence
+
+__all__ = ["COMMANDS", "build_parser", "main"]
+
+COMMANDS: dict[str, str] = {
+    "demo": "the paper's three-rod demo: video, plates, plots and scorecard",
+    "train": "train an SB3 agent (PPO, SAC, TD3, SAC+HER) with harness evaluation",
+    "demos": "record seeded expert demonstrations to an npz file",
+    "evaluate": "score policies on envs with the shared harness: tables, CSV, JSON, plots",
+    "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="sgc", description="Sequential-goal constraints: environments, expert, benchmark."
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, help_text in COMMANDS.items():
+        module = importlib.import_module(f"sgc_env.commands.{name.replace('-', '_')}")
+        command_parser = sub.add_parser(name, help=help_text, description=help_text)
+        module.add_arguments(command_parser)
+        command_parser.set_defaults(_module=module)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return int(args._module.run(args) or 0)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

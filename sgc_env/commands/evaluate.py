@@ -1,0 +1,197 @@
+"""``sgc evaluate``: score one or more policies on one or more envs with the shared harness.
+
+One env and one policy: DIR (default ``runs/evaluate/<env>/<policy>``) gets ``goals.csv``,
+``summary.json``, ``goal_errors.png`` and ``speed_profile.png``. Several (``--policy a,b``,
+``--env all``): each pair goes to ``DIR/<env>/<policy>`` (default DIR ``runs/evaluate``) and
+DIR also gets ``scorecard.json`` and ``scorecard.md``, the comparison table printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
+
+#: (summary key, column title, format) of the comparison table.
+SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("success_rate", "success", ".2f"),
+    ("position_error_max", "pos err max (m)", ".1e"),
+    ("orientation_error_max", "ori err max (rad)", ".1e"),
+    ("position_closest_offset_abs_max", "closest offset abs max (s)", ".3f"),
+    ("sparc_track_mean", "SPARC track", ".2f"),
+    ("speed_minima_mean", "speed minima / ep", ".1f"),
+    ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
+    ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
+    ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
+    ("terminated", "terminated", "d"),
+)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--policy", action="append", metavar="SPEC",
+        help="expert | dynamic-constraints | minimum-jerk | random | path to an SB3 .zip; "
+        "repeat or comma-separate for a comparison (default: expert)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--env", action="append", metavar="ID",
+        help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
+        "id (default: SGCPoint-v0)",
+    )  # fmt: skip
+    parser.add_argument("--episodes", type=int, default=5, help="episodes per pair (default 5)")
+    parser.add_argument("--seed", type=int, default=1000, help="episode k uses seed + k")
+    parser.add_argument("--out", type=Path, default=None, help="output folder (see above)")
+    parser.add_argument("--tolerance-position", type=float, default=0.02, metavar="M")
+    parser.add_argument("--tolerance-orientation", type=float, default=0.05, metavar="RAD")
+    parser.add_argument(
+        "--tolerance-time", type=float, default=None, metavar="S",
+        help="success time tolerance (default: one control step)",
+    )  # fmt: skip
+    parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+
+
+def _split(values: Sequence[str] | None, default: str) -> list[str]:
+    items = [part.strip() for v in (values or [default]) for part in v.split(",")]
+    return [i for i in items if i]
+
+
+def expand_envs(names: Sequence[str]) -> list[str]:
+    """Env ids with ``all`` replaced by every SGC id whose observation is a flat Box."""
+    import gymnasium as gym
+
+    import sgc_env
+
+    out: list[str] = []
+    for name in names:
+        if name != "all":
+            out.append(name)
+            continue
+        for env_id in sgc_env.ENV_IDS:
+            env = gym.make(env_id)
+            flat = isinstance(env.observation_space, gym.spaces.Box)
+            env.close()
+            if flat:
+                out.append(env_id)
+    return list(dict.fromkeys(out))
+
+
+def _format(value: Any, fmt: str) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "–"
+    if fmt == "s":
+        return str(value)
+    return format(value, fmt)
+
+
+def markdown_table(summaries: Sequence[Mapping[str, Any]]) -> str:
+    """The comparison table in GitHub markdown (one row per env and policy)."""
+    head = "| " + " | ".join(title for _, title, _ in SCORECARD_COLUMNS) + " |"
+    rule = "|" + "|".join("---" for _ in SCORECARD_COLUMNS) + "|"
+    body = [
+        "| " + " | ".join(_format(s.get(k), f) for k, _, f in SCORECARD_COLUMNS) + " |"
+        for s in summaries
+    ]
+    return "\n".join([head, rule, *body]) + "\n"
+
+
+def _rich_table(summaries: Sequence[Mapping[str, Any]], title: str) -> Any:
+    from rich.table import Table
+
+    table = Table(title=title)
+    for _, name, fmt in SCORECARD_COLUMNS:
+        table.add_column(name, justify="left" if fmt == "s" else "right")
+    for s in summaries:
+        table.add_row(*(_format(s.get(k), f) for k, _, f in SCORECARD_COLUMNS))
+    return table
+
+
+def _goal_table(rows: Sequence[Mapping[str, Any]], limit: int = 40) -> Any:
+    from rich.table import Table
+
+    table = Table(title="episode 0, per goal")
+    columns = (
+        ("body", "d"), ("goal", "d"), ("time", ".3f"), ("position_error", ".2e"),
+        ("orientation_error", ".2e"), ("closest_approach_offset", "+.3f"),
+        ("entry_offset", "+.3f"), ("success", "s"),
+    )  # fmt: skip
+    for name, _ in columns:
+        table.add_column(name, justify="right")
+    for row in [r for r in rows if r["episode"] == 0][:limit]:
+        table.add_row(*(_format(row[name], fmt) for name, fmt in columns))
+    return table
+
+
+def _write_pair(result: Any, out: Path, plots: bool) -> None:
+    from baselines.evaluation import write_goals_csv, write_summary_json
+
+    write_goals_csv(result.rows, out / "goals.csv")
+    write_summary_json(result.summary, out / "summary.json")
+    if not plots:
+        return
+    from sgc_env.plots import plot_goal_errors, plot_speed_profile, trajectory_arrays
+
+    title = f"{result.policy} on {result.env_id}"
+    plot_goal_errors(result.rows, out / "goal_errors.png", title=title)
+    first = result.episodes[0]
+    if first.infos:
+        traj = trajectory_arrays(first.infos, first.initial_info)
+        plot_speed_profile(traj, first.goals, out / "speed_profile.png", title=f"{title}, ep 0")
+
+
+def run(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from baselines.evaluation import evaluate, json_ready
+    from baselines.policies import policy_label
+    from sgc_env.metrics import Tolerances
+
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=200)
+    try:
+        policies = _split(args.policy, "expert")
+        envs = expand_envs(_split(args.env, "SGCPoint-v0"))
+        tolerances = Tolerances(
+            args.tolerance_position, args.tolerance_orientation, args.tolerance_time
+        )
+    except ValueError as exc:
+        print(f"sgc evaluate: error: {exc}", file=sys.stderr)
+        return 2
+    single = len(policies) == 1 and len(envs) == 1
+    summaries = []
+    for env_id in envs:
+        for spec in policies:
+            label = policy_label(spec)
+            if single:
+                out = args.out or Path("runs/evaluate") / env_id / label
+            else:
+                out = (args.out or Path("runs/evaluate")) / env_id / label
+            try:
+                result = evaluate(spec, env_id, args.episodes, args.seed, tolerances=tolerances)
+            except ValueError as exc:
+                print(f"sgc evaluate: error: {exc}", file=sys.stderr)
+                return 2
+            _write_pair(result, out, not args.no_plots)
+            summaries.append(result.summary)
+            if single:
+                console.print(_goal_table(result.rows))
+            console.print(f"[dim]{env_id} / {label}: wrote {out}[/dim]")
+    title = f"{args.episodes} episode(s) from seed {args.seed}"
+    console.print(_rich_table(summaries, title))
+    if not single:
+        root = args.out or Path("runs/evaluate")
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "scorecard.json").write_text(
+            json.dumps(json_ready(summaries), indent=2, allow_nan=False) + "\n"
+        )
+        (root / "scorecard.md").write_text(markdown_table(summaries))
+        console.print(f"[dim]wrote {root / 'scorecard.md'} and scorecard.json[/dim]")
+    return 0

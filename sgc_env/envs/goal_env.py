@@ -1,0 +1,92 @@
+"""Goal-conditioned variant for hindsight relabelling (SB3's HerReplayBuffer).
+
+Dict observation:
+
+| key | size | meaning |
+|---|---|---|
+| observation | 13 n | per body: position, orientation, linear and angular velocity (no goal data) |
+| achieved_goal | 4 | tracked point of body 0 and the current time |
+| desired_goal | 4 | nail of body 0's current position goal and that goal's time (the deadline) |
+
+A goal is met when the point is within ``tolerance`` m of the nail *on the goal's tick*
+(|time difference| below half a control period): reward 0, else -1 (sparse, vectorised in
+:meth:`compute_reward`). The step reward is ``compute_reward(achieved after the step, desired
+before it)``, the same pairing HER uses, so relabelled rewards agree with the env's own.
+Physics, actions, termination and truncation are those of :class:`SGCEnv`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
+
+__all__ = ["SGCGoalEnv"]
+
+
+class SGCGoalEnv(SGCEnv):
+    """:class:`SGCEnv` with a Dict observation (observation, achieved_goal, desired_goal)."""
+
+    def __init__(self, *args: Any, tolerance: float = 0.02, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._init_kwargs["tolerance"] = tolerance
+        if self.tracks[0].position is None:
+            raise ValueError("the goal-conditioned env needs a position track on body 0")
+        self.tolerance = float(tolerance)
+        box = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (4,), np.float32)
+        self.observation_space = gym.spaces.Dict(
+            {
+                "observation": gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (13 * self._n,), np.float32),
+                "achieved_goal": box,
+                "desired_goal": box,
+            }
+        )
+
+    def _dict_obs(self) -> dict[str, np.ndarray]:
+        tr = self.tracks[0].position
+        k = self._pos_idx[0]
+        t = self._tick * self.dt
+        return {
+            "observation": self._block[:, 0:13].ravel().astype(np.float32),
+            "achieved_goal": np.array([*self._point_pos[0], t], dtype=np.float32),
+            "desired_goal": np.array([*tr.targets[k], tr.times[k]], dtype=np.float32),  # type: ignore[union-attr]
+        }
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        _, info = super().reset(seed=seed, options=options)
+        self._last = self._dict_obs()
+        return self._last, info
+
+    def step(
+        self, action: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        desired = self._last["desired_goal"]
+        _, _, terminated, truncated, info = super().step(action)
+        obs = self._dict_obs()
+        reward = float(self.compute_reward(obs["achieved_goal"], desired, info))
+        self._last = obs
+        return obs, reward, terminated, truncated, info
+
+    def restore_state(self, state: Any) -> dict[str, np.ndarray]:  # type: ignore[override]
+        super().restore_state(state)
+        self._last = self._dict_obs()
+        return self._last
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        super().__setstate__(state)
+        self._last = self._dict_obs()
+
+    def compute_reward(
+        self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any
+    ) -> np.ndarray:
+        """0 where the point is on the nail on the goal's tick, else -1; any leading shape."""
+        a = np.asarray(achieved_goal, dtype=np.float64)
+        d = np.asarray(desired_goal, dtype=np.float64)
+        dist = np.linalg.norm(a[..., :3] - d[..., :3], axis=-1)
+        on_time = np.abs(a[..., 3] - d[..., 3]) < 0.5 * self.dt
+        return np.where((dist <= self.tolerance) & on_time, 0.0, -1.0).astype(np.float32)

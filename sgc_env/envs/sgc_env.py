@@ -1,0 +1,684 @@
+"""The sequential-goal environment: rigid bodies driven by forces and torques on PyBullet.
+
+## Description
+
+Each body of a :class:`~sgc_env.scenario.Scenario` must meet a sequence of goals: a body point
+on a world nail and/or a body orientation, each at a goal time (Liu, Ko & Chang 1993). Goals
+are met *exactly* and *punctually* only by planning; nothing in the env snaps bodies to goals.
+
+## Action space
+
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz in the world frame,
+scaled by the body's ``force_limit`` (N) and ``torque_limit`` (N m). When every body is a
+sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
+the centre of mass; gravity is *not* compensated. The action is held for one control period
+(``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
+every substep.
+
+## Observation space
+
+Flat float32 ``Box`` (bounds +-1e5); per-body blocks then ``time``; offsets from
+``env.unwrapped.layout`` (:class:`~sgc_env.observation.ObservationLayout`):
+
+| field | size | meaning |
+|---|---|---|
+| position, orientation | 3, 4 | CoM (world), quaternion xyzw |
+| linear_velocity, angular_velocity | 3, 3 | world frame |
+| point_offset | 3 | the current position goal's body point (body frame) |
+| position_deviation | 3 | D = world point - current nail |
+| point_velocity | 3 | D' |
+| position_time_left | 1 | time to the current goal; after the last one, minus the time since it |
+| position_course_start, position_course_duration | 3, 1 | D_i(0) = previous nail - nail; T_i |
+| position_next_start, position_next_duration | 3, 1 | nail_i - nail_{i+1}; T_{i+1} (0 if last) |
+| position_end_velocity | 3 | last goal only: end velocity (default: last course average) |
+| position_flags | 2 | (has a position track, current goal is the last) |
+| orientation_* | 3,1,3,1,3,1,3,2 | the same for phi, R = Exp(phi) R_goal, unwrapped |
+| time | 1 | seconds since reset |
+
+The current goal advances on the tick of its time: the observation returned by the step that
+reaches t_i already describes goal i+1.
+
+## Rewards
+
+``r = -mean_b(|D_b| / L_b + |phi_b| / A_b) - 0.01 * mean(a^2) + sum over goals met this tick of
+exp(-|D| / 0.01 m) (+ exp(-|phi| / 0.02 rad))``, with ``L_b = max(|D_i(0)|, 0.1 m)`` and
+``A_b = max(|phi_i(0)|, 0.5 rad)`` of the current course. Dense, bounded by the bonus.
+
+## Episode end
+
+``truncated`` at the last goal time + ``scenario.margin`` (reaching a goal never ends an
+episode). ``terminated`` on failure: non-finite state, a body CoM outside the workspace box, or
+a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s; a
+thin rod's axial spin reaches that within a step under random torques, so it is not terminal:
+``info["spin_clamped"]`` flags it (the physics is then no longer exact).
+
+## Info
+
+Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_goal_index``
+(index into the body's goal list, -1 without a track), ``position_deviation``,
+``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
+``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
+``{body, goal, time, position_error, orientation_error}`` (norms of D and phi at that tick;
+None for a missing part).
+
+## Arguments
+
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
+:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
+reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
+an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
+distance, yaw, pitch, target, width, height). ``reset(options={"scenario": ...})`` swaps the
+scenario (same number of bodies and action size; a random-scenario env draws again on the next
+plain reset).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from sgc_env.observation import BASE_BLOCK_SIZE, ObservationLayout, split_precision
+from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.random_scenarios import random_scenario as draw_random_scenario
+from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
+from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
+from sgc_env.simulator import Simulator, pybullet
+
+from .tracks import (
+    BodyTracks,
+    compile_tracks,
+    quat_conj_mul,
+    rotate,
+    rotvec_from_quat,
+    unwrap_rotvec,
+)
+
+__all__ = ["SGCEnv", "SavedState"]
+
+OBS_BOUND = 1e5
+MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
+SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
+
+# Offsets inside a body block (see sgc_env.observation.BODY_FIELDS).
+_BLOCK = ObservationLayout(1)
+_DEV = _BLOCK.body_slice(0, "position_deviation").start  # then point_velocity, time left
+_PTL = _BLOCK.body_slice(0, "position_time_left").start
+_ODEV = _BLOCK.body_slice(0, "orientation_deviation").start  # then orientation time left
+_OTL = _BLOCK.body_slice(0, "orientation_time_left").start
+
+
+@dataclass(frozen=True)
+class SavedState:
+    """A snapshot from :meth:`SGCEnv.save_state`: the PyBullet state id plus env counters."""
+
+    bullet_state: int
+    counters: dict[str, Any]
+
+
+def _with(array: np.ndarray, i: int, value: int) -> np.ndarray:
+    out = array.copy()
+    out[i] = value
+    return out
+
+
+def _as_scenario(spec: Scenario | str | Path) -> Scenario:
+    return spec if isinstance(spec, Scenario) else load_scenario(spec)
+
+
+def _geometry(s: Scenario) -> tuple:
+    return (
+        tuple((b.name, b.shape, b.size, b.mass, b.color, b.collisions) for b in s.bodies),
+        tuple((p.name, p.shape, p.size, p.color, p.collisions) for p in s.props),
+    )
+
+
+class SGCEnv(gym.Env):
+    """Sequential-goal constraints on free rigid bodies (see the module docstring)."""
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 60}
+
+    def __init__(
+        self,
+        scenario: Scenario | str | Path | None = None,
+        *,
+        random_scenario: RandomScenarioConfig | str | None = None,
+        control_frequency: int | None = None,
+        sim_frequency: int = 240,
+        time_grid: str | None = None,
+        render_mode: str | None = None,
+        camera: dict[str, Any] | None = None,
+    ) -> None:
+        self._init_kwargs = {
+            "scenario": scenario, "random_scenario": random_scenario,
+            "control_frequency": control_frequency, "sim_frequency": sim_frequency,
+            "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
+        }  # fmt: skip
+        if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
+            raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
+        if scenario is None and random_scenario is None:
+            raise ValueError(
+                "give a scenario (object, built-in name or YAML path) or random_scenario"
+            )
+        self.render_mode = render_mode
+        self.camera = CameraConfig.from_dict(camera)
+        self._random_config: RandomScenarioConfig | None = None
+        if scenario is None:
+            cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
+            if control_frequency is not None:
+                cfg = RandomScenarioConfig(
+                    **{**cfg.__dict__, "control_frequency": control_frequency}
+                )
+            self._random_config = cfg
+            base = draw_random_scenario(np.random.default_rng(0), cfg)
+        else:
+            base = _as_scenario(scenario)
+        self._control_override = control_frequency
+        self._time_grid = time_grid
+        base = self._resolve(base)
+        self.sim_frequency = int(sim_frequency)
+        cf = base.control_frequency
+        if self.sim_frequency <= 0 or self.sim_frequency % cf:
+            raise ValueError(
+                f"sim_frequency {sim_frequency} Hz must be a positive integer multiple of the "
+                f"control frequency {cf} Hz"
+            )
+        self.control_frequency = cf
+        self.substeps = self.sim_frequency // cf
+        h = 1.0 / self.sim_frequency
+        self._substep_coef = [(k * h, h * h * k * (k + 1) / 2) for k in range(self.substeps)]
+        self.dt = 1.0 / cf
+        # "human" is offered only where a display exists, so headless checkers do not open a GUI.
+        self.metadata = {
+            **type(self).metadata,
+            "render_fps": cf,
+            "render_modes": available_render_modes(),
+        }
+        self._n = len(base.bodies)
+        self.use_torque = not all(
+            b.shape == "sphere" and not b.has_orientation_track for b in base.bodies
+        )
+        per = 6 if self.use_torque else 3
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (per * self._n,), np.float32)
+        self._action_shape = self.action_space.shape
+        self.layout = ObservationLayout(self._n, tuple(b.name for b in base.bodies))
+        self.observation_space = gym.spaces.Box(
+            -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
+        )
+        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        self._get_pose = pybullet.getBasePositionAndOrientation
+        self._get_velocity = pybullet.getBaseVelocity
+        self._markers: NailMarkers | None = None
+        self.scenario: Scenario = base
+        self._geometry: tuple = ()
+        self._build(base)
+        self._set_scenario(base)
+        self._reset_state()
+
+    # ---------------------------------------------------------------- scenario handling
+
+    def _resolve(self, s: Scenario) -> Scenario:
+        if (
+            s.resolved
+            and self._control_override in (None, s.control_frequency)
+            and self._time_grid is None
+        ):
+            return s
+        return resolve_scenario(
+            s, control_frequency=self._control_override, time_grid=self._time_grid
+        )
+
+    def _build(self, s: Scenario) -> None:
+        """Create bodies and props (once per geometry; resets only move them)."""
+        for name in list(self.sim.bodies):
+            self.sim.remove_body(name)
+        for b in s.bodies:
+            self.sim.add_body(b.name, b.shape, b.size, b.mass, b.color, collisions=b.collisions)
+        for p in s.props:
+            self.sim.add_body(
+                p.name, p.shape, p.size, 0.0, p.color, kinematic=True, collisions=p.collisions
+            )
+        self._uids = [self.sim.bodies[b.name].uid for b in s.bodies]
+        self._prop_uids = [self.sim.bodies[p.name].uid for p in s.props]
+        self.body_inertia = np.array([self.sim.inertia_diagonal(b.name) for b in s.bodies])
+        self._geometry = _geometry(s)
+        if self._markers is not None:
+            self._markers.clear()
+
+    def _set_scenario(self, s: Scenario) -> None:
+        if len(s.bodies) != self._n:
+            raise ValueError(
+                f"scenario has {len(s.bodies)} bodies, this env was made for {self._n}"
+            )
+        use_torque = not all(b.shape == "sphere" and not b.has_orientation_track for b in s.bodies)
+        if use_torque and not self.use_torque:
+            raise ValueError("scenario needs torques but this env's action space has forces only")
+        if s.control_frequency != self.control_frequency:
+            raise ValueError(
+                f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
+                f"{self.control_frequency} Hz"
+            )
+        if _geometry(s) != self._geometry:
+            self._build(s)
+        self.scenario = s
+        self.sim.set_gravity(s.gravity)
+        self._gravity = tuple(float(g) for g in s.gravity)
+        self.tracks: list[BodyTracks] = compile_tracks(s)
+        self._has_pos = [bt.position is not None for bt in self.tracks]
+        self._has_ori = [bt.orientation is not None for bt in self.tracks]
+        self._init_caches()
+        self._mass = [b.mass for b in s.bodies]
+        self._flimit = [float(b.force_limit) for b in s.bodies]
+        self._tlimit = [float(b.torque_limit) for b in s.bodies]
+        self._ws_low, self._ws_high = (
+            tuple(map(float, s.workspace[0])),
+            tuple(map(float, s.workspace[1])),
+        )
+        last_tick = max(
+            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
+        )
+        self.max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        self._prop_table = self._prop_positions(s)
+        if self._markers is not None:
+            self._markers.place(s)
+
+    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, float, float]]]:
+        """Kinematic prop positions at every substep time of the episode (computed once)."""
+        if not s.props:
+            return []
+        n_sub = (self.max_steps + 1) * self.substeps + 1
+        t = np.arange(n_sub) / self.sim_frequency
+        table = []
+        for p in s.props:
+            if p.waypoints:
+                times = [w[0] for w in p.waypoints]
+                pts = np.asarray([w[1] for w in p.waypoints])
+                xyz = np.stack([np.interp(t, times, pts[:, j]) for j in range(3)], axis=1)
+            else:
+                xyz = np.asarray(p.position) + np.outer(t, p.velocity)
+            table.append(xyz)
+        arr = np.stack(table, axis=1)
+        return [[tuple(map(float, row)) for row in step] for step in arr]
+
+    # ---------------------------------------------------------------- reset / step
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        options = options or {}
+        if options.get("scenario") is not None:
+            self._set_scenario(self._resolve(_as_scenario(options["scenario"])))
+        elif self._random_config is not None:
+            self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
+        self._reset_state()
+        info = self._info([])
+        if self.render_mode == "human":
+            self.render()
+        return self._obs, info
+
+    def _reset_state(self) -> None:
+        for uid, b in zip(self._uids, self.scenario.bodies, strict=True):
+            self.sim.reset_body(
+                uid, b.position, b.orientation, b.linear_velocity, b.angular_velocity
+            )
+        if self._prop_uids:
+            for uid, pos in zip(self._prop_uids, self._prop_table[0], strict=True):
+                self.sim.move(uid, pos)
+        self._tick = 0
+        self._zeros3n = [0.0] * (3 * self._n)
+        self._applied = [0.0] * (6 * self._n)
+        self._pos_idx = [0] * self._n
+        self._ori_idx = [0] * self._n
+        self._phi = [
+            tr.orientation.course_start[0].tolist() if tr.orientation else [0.0] * 3
+            for tr in self.tracks
+        ]
+        for i in range(self._n):
+            self._write_static(i)
+        self._observe()
+
+    def _write_static(self, i: int) -> None:
+        """Cache what changes only when a body's current goal changes (as Python tuples)."""
+        zeros13 = (0.0,) * 13
+        tr = self.tracks[i].position
+        if tr is not None:
+            k = self._pos_idx[i]
+            last = k == tr.size - 1
+            end_v = tuple(tr.end_velocity) if last else (0.0, 0.0, 0.0)
+            self._s_offset[i] = tuple(tr.points[k].tolist())
+            self._s_nail[i] = tuple(tr.targets[k].tolist())
+            self._s_ptime[i] = float(tr.times[k])
+            self._s_pos[i] = (
+                *tr.course_start[k].tolist(), float(tr.durations[k]), *tr.next_start[k].tolist(),
+                float(tr.next_duration[k]), *end_v, 1.0, float(last),
+            )  # fmt: skip
+            self._s_pscale[i] = 1.0 / max(float(np.linalg.norm(tr.course_start[k])), 0.1)
+            self._goal_index = _with(self._goal_index, i, int(tr.goal_ids[k]))
+        else:
+            self._s_offset[i] = (0.0, 0.0, 0.0)
+            self._s_pos[i] = zeros13
+        to = self.tracks[i].orientation
+        if to is not None:
+            k = self._ori_idx[i]
+            last = k == to.size - 1
+            end_w = tuple(to.end_velocity) if last else (0.0, 0.0, 0.0)
+            self._s_quat[i] = tuple(to.targets[k].tolist())
+            self._s_otime[i] = float(to.times[k])
+            self._s_ori[i] = (
+                *to.course_start[k].tolist(), float(to.durations[k]), *to.next_start[k].tolist(),
+                float(to.next_duration[k]), *end_w, 1.0, float(last),
+            )  # fmt: skip
+            self._s_oscale[i] = 1.0 / max(float(np.linalg.norm(to.course_start[k])), 0.5)
+            self._ori_goal_index = _with(self._ori_goal_index, i, int(to.goal_ids[k]))
+        else:
+            self._s_ori[i] = zeros13
+        self._next_event = self._first_pending_tick()
+
+    def _first_pending_tick(self) -> int:
+        """The earliest goal tick still ahead of the current tick (-1 when none is left)."""
+        ticks = []
+        for j, bt in enumerate(self.tracks):
+            if bt.position is not None:
+                ticks.append(int(bt.position.ticks[self._pos_idx[j]]))
+            if bt.orientation is not None:
+                ticks.append(int(bt.orientation.ticks[self._ori_idx[j]]))
+        ahead = [k for k in ticks if k > self._tick]
+        return min(ahead) if ahead else -1
+
+    def _init_caches(self) -> None:
+        n = self._n
+        self._s_offset: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
+        self._s_nail: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
+        self._s_quat: list[tuple[float, ...]] = [(0.0, 0.0, 0.0, 1.0)] * n
+        self._s_ptime = [0.0] * n
+        self._s_otime = [0.0] * n
+        self._s_pos: list[tuple[float, ...]] = [()] * n
+        self._s_ori: list[tuple[float, ...]] = [()] * n
+        self._s_pscale = [0.0] * n
+        self._s_oscale = [0.0] * n
+        self._goal_index = np.full(n, -1)
+        self._ori_goal_index = np.full(n, -1)
+
+    def _observe(self, read: bool = True) -> None:
+        """Read every body once and build the observation, deviations and failure flags.
+
+        Pure-Python arithmetic on tuples and a single array construction: for a few bodies
+        that is several times cheaper than numpy calls on 3-vectors. ``read=False`` rebuilds
+        from the last read (after a goal switch) without calling PyBullet again.
+        """
+        if read:
+            get_p, get_v, c = self._get_pose, self._get_velocity, self.sim.client
+            self._states = [
+                get_p(uid, physicsClientId=c) + get_v(uid, physicsClientId=c) for uid in self._uids
+            ]
+        states = self._states
+        n = self._n
+        t = self._tick * self.dt
+        flat: list[float] = []
+        points = []
+        cost = 0.0
+        ok = True
+        spin = 0.0
+        lo, hi = self._ws_low, self._ws_high
+        for i, (pos, orn, lin, ang) in enumerate(states):
+            offset = self._s_offset[i]
+            if offset == (0.0, 0.0, 0.0):
+                r, p = offset, pos
+            else:
+                r = rotate(orn, offset)
+                p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
+            points.append(p)
+            if self._has_pos[i]:
+                nail = self._s_nail[i]
+                wx, wy, wz = ang
+                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
+                dyn = (
+                    dx, dy, dz, lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
+                    lin[2] + wx * r[1] - wy * r[0], self._s_ptime[i] - t,
+                )  # fmt: skip
+                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * self._s_pscale[i]
+            else:
+                dyn = (0.0,) * 7
+            if self._has_ori[i]:
+                phi = unwrap_rotvec(
+                    rotvec_from_quat(quat_conj_mul(orn, self._s_quat[i])), self._phi[i]
+                )
+                self._phi[i] = phi
+                odyn = (*phi, self._s_otime[i] - t)
+                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * self._s_oscale[i]
+            else:
+                odyn = (0.0, 0.0, 0.0, 0.0)
+            flat += pos + orn + lin + ang + offset + dyn + self._s_pos[i] + odyn + self._s_ori[i]
+            ax, ay, az = ang
+            spin = max(spin, ax * ax + ay * ay + az * az)
+            if ok:
+                vx, vy, vz = lin
+                # NaN fails every comparison, so this also catches non-finite states; with the
+                # workspace inside +-1e4 it keeps the observation inside its bounds.
+                ok = (
+                    lo[0] < pos[0] < hi[0] and lo[1] < pos[1] < hi[1] and lo[2] < pos[2] < hi[2]
+                    and vx * vx + vy * vy + vz * vz < MAX_SPEED**2
+                    and spin == spin
+                )  # fmt: skip
+        flat.append(t)
+        for p in points:
+            flat += p
+        flat += self._applied
+        # One array holds the observation, then point positions, forces and torques, so the
+        # info entries are views instead of separate allocations.
+        arr = np.array(flat)
+        size = n * BASE_BLOCK_SIZE + 1
+        self._block = arr[: size - 1].reshape(n, BASE_BLOCK_SIZE)
+        self._obs = np.append(split_precision(self._block).ravel(), np.float32(t))
+        self._tail = arr[size:].reshape(3, n, 3)
+        self._point_pos = points
+        self._cost = cost
+        self._failed = not ok
+        self._spin_clamped = spin >= SPIN_CLAMP**2
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
+        if a.shape != self._action_shape:
+            raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
+        values = a.tolist()
+        if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
+            raise ValueError(f"action contains non-finite values: {values}")
+        values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
+        per = 6 if self.use_torque else 3
+        gx, gy, gz = self._gravity
+        forces, torques, applied_f, applied_t = [], [], [], []
+        com_positions: list[list[tuple[float, float, float]]] = [[] for _ in self._substep_coef]
+        for i, (pos, _, lin, _) in enumerate(self._states):
+            fl = self._flimit[i]
+            o = i * per
+            fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
+            f = (fx, fy, fz)
+            forces.append(f)
+            applied_f += f
+            if per == 6:
+                tl = self._tlimit[i]
+                tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
+                torques.append(tq)
+                applied_t += tq
+            m = self._mass[i]
+            ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
+            x0, y0, z0 = pos
+            vx, vy, vz = lin
+            # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
+            for row, (kh, c) in zip(com_positions, self._substep_coef, strict=True):
+                row.append((x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az))
+        moves: list[list[tuple[int, tuple[float, float, float]]]] = []
+        if self._prop_uids:
+            base = self._tick * self.substeps
+            last = len(self._prop_table) - 1  # props hold still if stepped past truncation
+            moves = [
+                list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
+                for k in range(self.substeps)
+            ]
+        self.sim.step_bodies(
+            self._uids, forces, torques if self.use_torque else None, com_positions, moves
+        )
+        self._applied = applied_f + (applied_t or self._zeros3n)
+        self._tick += 1
+        self._observe()
+        events = self._advance_goals() if self._tick >= self._next_event >= 0 else []
+        reward = self._reward(values, events)
+        terminated = self._failed
+        truncated = (not terminated) and self._tick >= self.max_steps
+        info = self._info(events)
+        if self.render_mode == "human":
+            self.render()
+        return self._obs, reward, terminated, truncated, info
+
+    def _advance_goals(self) -> list[dict[str, Any]]:
+        """Record goals whose tick is now, then move the observation to the next goals."""
+        events: list[dict[str, Any]] = []
+        tick = self._tick
+        any_changed = False
+        for i, bt in enumerate(self.tracks):
+            changed = False
+            hits: dict[int, dict[str, Any]] = {}
+            tr, to = bt.position, bt.orientation
+            if tr is not None and tr.ticks[self._pos_idx[i]] == tick:
+                k = self._pos_idx[i]
+                d = self._block[i, _DEV : _DEV + 3]
+                g = int(tr.goal_ids[k])
+                hits[g] = {
+                    "body": i,
+                    "goal": g,
+                    "time": tick * self.dt,
+                    "position_error": float(math.sqrt(d @ d)),
+                    "orientation_error": None,
+                }
+                if k < tr.size - 1:
+                    self._pos_idx[i] = k + 1
+                    changed = True
+            if to is not None and to.ticks[self._ori_idx[i]] == tick:
+                k = self._ori_idx[i]
+                phi = self._phi[i]
+                g = int(to.goal_ids[k])
+                ev = hits.setdefault(
+                    g, {"body": i, "goal": g, "time": tick * self.dt, "position_error": None}
+                )
+                ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+                if k < to.size - 1:
+                    self._ori_idx[i] = k + 1
+                    start = to.course_start[k + 1]
+                    self._phi[i] = (phi[0] + start[0], phi[1] + start[1], phi[2] + start[2])
+                    changed = True
+            for g in sorted(hits):
+                events.append(hits[g])
+            if changed:
+                self._write_static(i)
+                any_changed = True
+        if any_changed:
+            self._observe(read=False)
+        self._next_event = self._first_pending_tick()
+        return events
+
+    def _reward(self, values: list[float], events: list[dict[str, Any]]) -> float:
+        reward = -self._cost / self._n - 0.01 * sum(x * x for x in values) / len(values)
+        for ev in events:
+            if ev["position_error"] is not None:
+                reward += math.exp(-ev["position_error"] / 0.01)
+            if ev["orientation_error"] is not None:
+                reward += math.exp(-ev["orientation_error"] / 0.02)
+        return reward
+
+    def _info(self, events: list[dict[str, Any]]) -> dict[str, Any]:
+        block = self._block
+        info: dict[str, Any] = {
+            "time": self._tick * self.dt,
+            "goal_index": self._goal_index.copy(),
+            "orientation_goal_index": self._ori_goal_index.copy(),
+            "position_deviation": block[:, _DEV : _DEV + 3],
+            "orientation_deviation": block[:, _ODEV : _ODEV + 3],
+            "time_to_goal": block[:, _PTL],
+            "orientation_time_to_goal": block[:, _OTL],
+            "body_position": block[:, 0:3],
+            "body_orientation": block[:, 3:7],
+            "body_velocity": block[:, 7:10],
+            "body_angular_velocity": block[:, 10:13],
+            "point_position": self._tail[0],
+            "point_velocity": block[:, _DEV + 3 : _DEV + 6],
+            "force": self._tail[1],
+            "torque": self._tail[2],
+            "spin_clamped": self._spin_clamped,
+        }
+        if events:
+            info["goal_reached"] = events
+        return info
+
+    def _counters(self) -> dict[str, Any]:
+        return {
+            "tick": self._tick,
+            "pos_idx": list(self._pos_idx),
+            "ori_idx": list(self._ori_idx),
+            "phi": [list(p) for p in self._phi],
+            "scenario": self.scenario,
+        }
+
+    def _apply_counters(self, c: dict[str, Any]) -> None:
+        if c["scenario"] is not self.scenario:
+            self._set_scenario(c["scenario"])
+        self._tick = c["tick"]
+        self._pos_idx = list(c["pos_idx"])
+        self._ori_idx = list(c["ori_idx"])
+        self._phi = [list(p) for p in c["phi"]]
+        for i in range(self._n):
+            self._write_static(i)
+
+    def save_state(self) -> SavedState:
+        """Snapshot physics (PyBullet saveState, in memory) and the env's goal counters."""
+        return SavedState(self.sim.save_state(), self._counters())
+
+    def restore_state(self, state: SavedState) -> np.ndarray:
+        """Return to a :meth:`save_state` snapshot; returns the observation there."""
+        self.sim.restore_state(state.bullet_state)
+        self._apply_counters(state.counters)
+        self._observe()
+        return self._obs
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {
+            "init_kwargs": self._init_kwargs,
+            "counters": self._counters(),
+            "bullet": self.sim.state_bytes(),
+            "rng": None if self._np_random is None else self._np_random.bit_generator.state,
+        }
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init_kwargs"])  # type: ignore[misc]
+        self._apply_counters(state["counters"])
+        self.sim.load_state_bytes(state["bullet"])
+        if state["rng"] is not None:
+            rng = np.random.default_rng()
+            rng.bit_generator.state = state["rng"]
+            self._np_random = rng
+        self._observe()
+
+    # ---------------------------------------------------------------- rendering
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
+            return None
+        if self._markers is None:
+            self._markers = NailMarkers(self.sim)
+            self._markers.place(self.scenario)
+        if self.render_mode == "rgb_array":
+            return self.camera.image(self.sim)
+        self.camera.point_gui(self.sim)
+        return None
+
+    def close(self) -> None:
+        if getattr(self, "sim", None) is not None:
+            self.sim.close()
+            self.sim = None  # type: ignore[assignment]
+        super().close()

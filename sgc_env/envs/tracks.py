@@ -1,0 +1,212 @@
+"""Per-body goal tracks compiled from a resolved scenario (the env's "task" data).
+
+A body's goals split into a position track (goals with a nail) and an orientation track
+(goals with an orientation part). Everything the observation needs about the current and next
+course is precomputed here once per scenario, so a control step only indexes arrays.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgc_env.scenario import Body, Scenario
+
+__all__ = [
+    "BodyTracks",
+    "Track",
+    "compile_tracks",
+    "quat_conj_mul",
+    "quat_mul",
+    "rotate",
+    "rotvec_from_quat",
+    "unwrap_rotvec",
+]
+
+
+def quat_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
+    """Hamilton product a*b in (x, y, z, w) order: the rotation R_a R_b."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def quat_conj_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
+    """a * conj(b): the rotation R_a R_b^T."""
+    return quat_mul(a, (-b[0], -b[1], -b[2], b[3]))
+
+
+def rotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
+    """R(q) v without building a matrix (pure Python: cheaper than numpy for one vector)."""
+    x, y, z, w = q
+    vx, vy, vz = v
+    tx = 2.0 * (y * vz - z * vy)
+    ty = 2.0 * (z * vx - x * vz)
+    tz = 2.0 * (x * vy - y * vx)
+    return (
+        vx + w * tx + (y * tz - z * ty),
+        vy + w * ty + (z * tx - x * tz),
+        vz + w * tz + (x * ty - y * tx),
+    )
+
+
+def rotvec_from_quat(q: Sequence[float]) -> tuple[float, float, float]:
+    """Principal rotation vector (angle in [0, pi]) of a unit quaternion."""
+    x, y, z, w = q
+    if w < 0.0:
+        x, y, z, w = -x, -y, -z, -w
+    s = math.sqrt(x * x + y * y + z * z)
+    if s < 1e-12:
+        return (2.0 * x, 2.0 * y, 2.0 * z)
+    k = 2.0 * math.atan2(s, w) / s
+    return (k * x, k * y, k * z)
+
+
+def quat_from_rotvec(r: Sequence[float]) -> tuple[float, float, float, float]:
+    angle = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+    if angle < 1e-12:
+        q = (0.5 * r[0], 0.5 * r[1], 0.5 * r[2], 1.0)
+    else:
+        s = math.sin(0.5 * angle) / angle
+        q = (s * r[0], s * r[1], s * r[2], math.cos(0.5 * angle))
+    n = math.sqrt(sum(c * c for c in q))
+    return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+
+
+def unwrap_rotvec(
+    principal: Sequence[float], reference: Sequence[float]
+) -> tuple[float, float, float]:
+    """The rotation vector of the same rotation that lies closest to ``reference``.
+
+    Same rotation = axis * (angle + 2 pi k) for any integer k, so the deviation phi stays
+    continuous across steps and a somersault's |phi| can exceed pi.
+    """
+    px, py, pz = principal
+    angle = math.sqrt(px * px + py * py + pz * pz)
+    rx, ry, rz = reference
+    if angle < 1e-12:
+        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
+        if rn < math.pi:
+            return (px, py, pz)
+        ux, uy, uz = rx / rn, ry / rn, rz / rn
+    else:
+        ux, uy, uz = px / angle, py / angle, pz / angle
+    s = ux * rx + uy * ry + uz * rz
+    k = round((s - angle) / (2.0 * math.pi))
+    if k == 0:
+        return (px, py, pz)
+    a = angle + 2.0 * math.pi * k
+    return (ux * a, uy * a, uz * a)
+
+
+@dataclass
+class Track:
+    """One track of one body (position or orientation), arrays indexed by track goal."""
+
+    goal_ids: np.ndarray  # index of each track goal in the body's goal list
+    ticks: np.ndarray  # control tick of each goal (int)
+    times: np.ndarray
+    targets: np.ndarray  # nails (m, 3) or goal quaternions (m, 4)
+    points: np.ndarray  # body points (m, 3); zeros for orientation
+    course_start: np.ndarray  # (m, 3) nominal deviation at the start of each course
+    durations: np.ndarray  # (m,)
+    next_start: np.ndarray  # (m, 3); zeros for the last
+    next_duration: np.ndarray  # (m,)
+    end_velocity: np.ndarray  # (3,)
+
+    @property
+    def size(self) -> int:
+        return len(self.ticks)
+
+
+@dataclass
+class BodyTracks:
+    position: Track | None
+    orientation: Track | None
+
+
+def _empty(n_target: int) -> Track:
+    z = np.zeros((0, 3))
+    return Track(
+        np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, n_target)), z, z, np.zeros(0),
+        z, np.zeros(0), np.zeros(3),
+    )  # fmt: skip
+
+
+def _finish(track: Track) -> Track:
+    m = track.size
+    track.durations = np.diff(np.concatenate(([0.0], track.times)))
+    track.next_start = np.zeros((m, 3))
+    track.next_duration = np.zeros(m)
+    if m > 1:
+        track.next_start[:-1] = track.course_start[1:]
+        track.next_duration[:-1] = track.durations[1:]
+    return track
+
+
+def _position_track(body: Body, freq: int) -> Track | None:
+    ids = [j for j, g in enumerate(body.goals) if g.has_position]
+    if not ids:
+        return None
+    goals = [body.goals[j] for j in ids]
+    times = np.array([float(g.time) for g in goals])  # type: ignore[arg-type]
+    nails = np.array([g.nail for g in goals], float)
+    points = np.array([g.point for g in goals], float)
+    start_point = np.add(body.position, rotate(body.orientation, points[0]))
+    prev = np.vstack((start_point, nails[:-1]))
+    course_start = prev - nails
+    if body.end_velocity is not None:
+        end_v = np.asarray(body.end_velocity, float)
+    else:
+        end_v = (nails[-1] - prev[-1]) / (times[-1] - (times[-2] if len(times) > 1 else 0.0))
+    track = Track(
+        np.array(ids), np.rint(times * freq).astype(int), times, nails, points, course_start,
+        np.zeros(0), np.zeros(0), np.zeros(0), end_v,
+    )  # fmt: skip
+    return _finish(track)
+
+
+def _orientation_track(body: Body, freq: int) -> Track | None:
+    ids = [j for j, g in enumerate(body.goals) if g.has_orientation]
+    if not ids:
+        return None
+    quats, starts = [], []
+    prev_q = tuple(body.orientation)
+    for j in ids:
+        g = body.goals[j]
+        if g.relative_rotation is not None:
+            rel = tuple(float(x) for x in g.relative_rotation)
+            q = quat_mul(quat_from_rotvec(rel), prev_q)
+            start = (-rel[0], -rel[1], -rel[2])
+        else:
+            q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
+            start = rotvec_from_quat(quat_conj_mul(prev_q, q))
+        quats.append(q)
+        starts.append(start)
+        prev_q = q
+    times = np.array([float(body.goals[j].time) for j in ids])  # type: ignore[arg-type]
+    end_w = (
+        np.zeros(3) if body.end_angular_velocity is None else np.asarray(body.end_angular_velocity)
+    )
+    track = Track(
+        np.array(ids), np.rint(times * freq).astype(int), times, np.array(quats),
+        np.zeros((len(ids), 3)),
+        np.array(starts, float), np.zeros(0), np.zeros(0), np.zeros(0), end_w.astype(float),
+    )  # fmt: skip
+    return _finish(track)
+
+
+def compile_tracks(scenario: Scenario) -> list[BodyTracks]:
+    """Tracks of every body of a resolved scenario."""
+    if not scenario.resolved:
+        raise ValueError("compile_tracks needs a resolved scenario (see resolve_scenario)")
+    f = scenario.control_frequency
+    return [BodyTracks(_position_track(b, f), _orientation_track(b, f)) for b in scenario.bodies]

@@ -1,0 +1,159 @@
+"""Named slices of the flat observation (the observation contract of docs/design.md).
+
+Policies and metrics address observation entries by name through :class:`ObservationLayout`
+so that nobody hard-codes offsets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = [
+    "BASE_BLOCK_SIZE",
+    "BASE_FIELDS",
+    "BODY_BLOCK_SIZE",
+    "BODY_FIELDS",
+    "GLOBAL_FIELDS",
+    "RESIDUAL_FIELDS",
+    "ObservationLayout",
+    "split_precision",
+]
+
+BASE_FIELDS: tuple[tuple[str, int], ...] = (
+    ("position", 3),
+    ("orientation", 4),
+    ("linear_velocity", 3),
+    ("angular_velocity", 3),
+    ("point_offset", 3),
+    ("position_deviation", 3),
+    ("point_velocity", 3),
+    ("position_time_left", 1),
+    ("position_course_start", 3),
+    ("position_course_duration", 1),
+    ("position_next_start", 3),
+    ("position_next_duration", 1),
+    ("position_end_velocity", 3),
+    ("position_flags", 2),
+    ("orientation_deviation", 3),
+    ("orientation_time_left", 1),
+    ("orientation_course_start", 3),
+    ("orientation_course_duration", 1),
+    ("orientation_next_start", 3),
+    ("orientation_next_duration", 1),
+    ("orientation_end_velocity", 3),
+    ("orientation_flags", 2),
+)
+GLOBAL_FIELDS: tuple[tuple[str, int], ...] = (("time", 1),)
+
+RESIDUAL_FIELDS: tuple[str, ...] = (
+    "position_deviation",
+    "point_velocity",
+    "orientation",
+    "angular_velocity",
+    "linear_velocity",
+    "orientation_deviation",
+    "position_time_left",
+    "orientation_time_left",
+    "point_offset",
+)
+"""Fields whose double-precision value a policy may need: each gets a ``<field>_residual``.
+
+float32 resolves about 6e-8 of a value, not enough to put a body on a nail to 1e-9 m from the
+observation alone; ``float64(x) + float64(x_residual)`` recovers the double to ~1e-15.
+"""
+
+_SIZES = dict(BASE_FIELDS)
+BODY_FIELDS: tuple[tuple[str, int], ...] = BASE_FIELDS + tuple(
+    (f"{name}_residual", _SIZES[name]) for name in RESIDUAL_FIELDS
+)
+
+_BODY_OFFSETS: dict[str, tuple[int, int]] = {}
+_start = 0
+for _name, _size in BODY_FIELDS:
+    _BODY_OFFSETS[_name] = (_start, _start + _size)
+    _start += _size
+BODY_BLOCK_SIZE = _start
+BASE_BLOCK_SIZE = sum(size for _, size in BASE_FIELDS)
+_RESIDUAL_SOURCES = np.concatenate(
+    [np.arange(*_BODY_OFFSETS[name]) for name in RESIDUAL_FIELDS]
+)
+
+
+def split_precision(base_blocks: np.ndarray) -> np.ndarray:
+    """float32 body blocks (base fields, then residuals) from float64 base blocks (n, base)."""
+    high = base_blocks.astype(np.float32)
+    sources = base_blocks[:, _RESIDUAL_SOURCES]
+    low = (sources - high[:, _RESIDUAL_SOURCES]).astype(np.float32)
+    return np.concatenate([high, low], axis=1)
+
+
+@dataclass(frozen=True)
+class ObservationLayout:
+    """Offsets of every named entry for a scene with ``n_bodies`` bodies.
+
+    Body blocks come first, in scenario body order, followed by the global entries.
+    """
+
+    n_bodies: int
+    body_names: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        if self.n_bodies < 1:
+            raise ValueError(f"n_bodies must be >= 1, got {self.n_bodies}")
+        if self.body_names and len(self.body_names) != self.n_bodies:
+            raise ValueError("body_names must have one name per body")
+
+    @property
+    def body_block_size(self) -> int:
+        return BODY_BLOCK_SIZE
+
+    @property
+    def size(self) -> int:
+        return self.n_bodies * BODY_BLOCK_SIZE + sum(n for _, n in GLOBAL_FIELDS)
+
+    def body_offset(self, body_index: int) -> int:
+        if not 0 <= body_index < self.n_bodies:
+            raise IndexError(f"body_index {body_index} out of range for {self.n_bodies} bodies")
+        return body_index * BODY_BLOCK_SIZE
+
+    def has_body_field(self, field_name: str) -> bool:
+        return field_name in _BODY_OFFSETS
+
+    def body_slice(self, body_index: int, field_name: str) -> slice:
+        """Slice of ``field_name`` of body ``body_index`` in the flat observation."""
+        if field_name not in _BODY_OFFSETS:
+            raise KeyError(f"unknown body field {field_name!r}; known: {sorted(_BODY_OFFSETS)}")
+        a, b = _BODY_OFFSETS[field_name]
+        base = self.body_offset(body_index)
+        return slice(base + a, base + b)
+
+    def global_slice(self, field_name: str) -> slice:
+        start = self.n_bodies * BODY_BLOCK_SIZE
+        for name, n in GLOBAL_FIELDS:
+            if name == field_name:
+                return slice(start, start + n)
+            start += n
+        raise KeyError(f"unknown global field {field_name!r}")
+
+    def field_slices(self) -> dict[str, slice]:
+        """Every entry by a qualified name ``'<body>.<field>'`` (body index or name) and globals."""
+        out: dict[str, slice] = {}
+        for i in range(self.n_bodies):
+            label = self.body_names[i] if self.body_names else str(i)
+            for name, _ in BODY_FIELDS:
+                out[f"{label}.{name}"] = self.body_slice(i, name)
+        for name, _ in GLOBAL_FIELDS:
+            out[name] = self.global_slice(name)
+        return out
+
+    def unpack(self, observation: np.ndarray) -> list[dict[str, np.ndarray]]:
+        """Per-body dictionaries of views into ``observation`` (for debugging and tests)."""
+        obs = np.asarray(observation)
+        if obs.shape[-1] != self.size:
+            raise ValueError(f"observation has {obs.shape[-1]} entries, layout expects {self.size}")
+        return [
+            {name: obs[..., self.body_slice(i, name)] for name, _ in BODY_FIELDS}
+            for i in range(self.n_bodies)
+        ]

@@ -1,0 +1,266 @@
+"""The paper's demo scene (Liu, Ko & Chang 1993, Plates 1-8), built from path functions.
+
+Three rods fly along designated paths, sampled into 25, 16 and 17 point-to-nail goals for
+their tips; near the start each tip pierces a red ball that moves kinematically; at the end
+each tip hits a target board at its own time and embeds itself in it. Orientation goals keep
+every rod pointing along its path's tangent; the teal rod turns one somersault on the way.
+
+``build_three_rods()`` returns the scenario as plain YAML-ready data;
+``python -m sgc_env.three_rods`` rewrites ``sgc_env/scenarios/three_rods.yaml`` from it (a
+test checks that the shipped file is what this module builds).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from scipy.interpolate import make_interp_spline
+from scipy.spatial.transform import Rotation
+
+__all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
+
+ROD_LENGTH = 1.0
+ROD_RADIUS = 0.025
+ROD_MASS = 1.0
+TIP = (0.0, 0.0, ROD_LENGTH / 2)
+BALL_RADIUS = 0.22
+PIERCE_TIME = 1.2
+EMBED_DEPTH = 0.12
+EMBED_DURATION = 0.1
+TARGET_FACE_X = 7.9
+TARGET_CENTER = (8.0, 0.0, 3.2)
+TARGET_HALF_EXTENTS = (0.1, 3.0, 2.2)
+FORCE_LIMIT = 150.0
+TORQUE_LIMIT = 30.0
+YAML_PATH = Path(__file__).parent / "scenarios" / "three_rods.yaml"
+
+
+@dataclass(frozen=True)
+class RodSpec:
+    """One rod: its tip's designated path, how it is sampled, and its red ball and target hit.
+
+    ``waypoints[ball_index]`` is where the tip pierces the ball at ``PIERCE_TIME``; the last
+    waypoint is on the target face, hit at ``hit_time``. The tip path is the cubic spline
+    through the waypoints; ``samples_before`` goals lie on the path up to the ball (the ball
+    included), ``samples_after`` from there to the target (the hit included), and one more goal
+    embeds the tip ``EMBED_DEPTH`` into the board, where the rod comes to rest.
+    """
+
+    name: str
+    color: tuple[float, float, float, float]
+    waypoints: tuple[tuple[float, float, float], ...]
+    ball_index: int
+    samples_before: int
+    samples_after: int
+    hit_time: float
+    ball_velocity: tuple[float, float, float]
+    somersault_sample: int | None = None
+
+    @property
+    def goal_count(self) -> int:
+        return self.samples_before + self.samples_after + 1
+
+
+ROD_SPECS: tuple[RodSpec, ...] = (
+    RodSpec(
+        name="rod_gold",
+        color=(0.95, 0.72, 0.15, 1.0),
+        waypoints=(
+            (-8.8, -3.0, 2.6), (-6.0, -2.6, 3.2), (-3.2, -3.6, 5.2), (-0.8, -5.0, 4.2),
+            (0.4, -3.6, 2.2), (-0.4, -2.0, 3.4), (2.6, -2.2, 5.4), (5.4, -1.6, 4.4),
+            (TARGET_FACE_X, -1.2, 3.6),
+        ),
+        ball_index=1,
+        samples_before=3,
+        samples_after=21,
+        hit_time=7.0,
+        ball_velocity=(0.0, 0.0, 0.8),
+    ),
+    RodSpec(
+        name="rod_teal",
+        color=(0.1, 0.7, 0.7, 1.0),
+        waypoints=(
+            (-8.8, 0.0, 4.0), (-6.2, 0.2, 4.6), (-2.2, 0.6, 6.0), (1.8, 0.0, 5.6),
+            (5.0, 0.4, 3.8), (TARGET_FACE_X, 0.3, 2.8),
+        ),
+        ball_index=1,
+        samples_before=3,
+        samples_after=12,
+        hit_time=7.5,
+        ball_velocity=(0.0, 1.0, 0.0),
+        somersault_sample=9,
+    ),
+    RodSpec(
+        name="rod_violet",
+        color=(0.55, 0.3, 0.85, 1.0),
+        waypoints=(
+            (-8.8, 3.0, 1.8), (-6.0, 2.6, 2.4), (-2.0, 5.0, 2.0), (2.0, 4.6, 4.0),
+            (5.0, 2.4, 4.4), (TARGET_FACE_X, 1.3, 3.2),
+        ),
+        ball_index=1,
+        samples_before=3,
+        samples_after=13,
+        hit_time=8.0,
+        ball_velocity=(-1.0, 0.0, 0.0),
+    ),
+)
+
+
+def _spline(points: np.ndarray):
+    """Cubic spline through ``points`` parametrised by cumulative chord length."""
+    chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    knots = np.concatenate(([0.0], np.cumsum(chord)))
+    return make_interp_spline(knots, points, k=3), knots
+
+
+def _arc_length_samples(spline, s0: float, s1: float, count: int) -> np.ndarray:
+    """Parameters of ``count`` points equally spaced in arc length on (s0, s1], s1 included."""
+    fine = np.linspace(s0, s1, 2001)
+    pts = spline(fine)
+    arc = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
+    wanted = arc[-1] * np.arange(1, count + 1) / count
+    params = np.interp(wanted, arc, fine)
+    params[-1] = s1
+    return params
+
+
+def _align(previous: Rotation, tangent: np.ndarray) -> Rotation:
+    """``previous`` turned by the smallest rotation that points its z axis along ``tangent``."""
+    axis_now = previous.apply([0.0, 0.0, 1.0])
+    t = tangent / np.linalg.norm(tangent)
+    cross = np.cross(axis_now, t)
+    angle = math.atan2(float(np.linalg.norm(cross)), float(axis_now @ t))
+    if angle < 1e-12:
+        return previous
+    return Rotation.from_rotvec(cross / np.linalg.norm(cross) * angle) * previous
+
+
+def _quat(r: Rotation) -> list[float]:
+    return [round(float(c), 12) for c in r.as_quat()]
+
+
+def _vec(v: np.ndarray) -> list[float]:
+    return [round(float(c), 12) for c in v]
+
+
+def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The rod's body entry (with goals) and its red ball's prop entry."""
+    points = np.asarray(spec.waypoints, dtype=float)
+    spline, knots = _spline(points)
+    tangent = spline.derivative()
+    params = np.concatenate(
+        (
+            _arc_length_samples(spline, knots[0], knots[spec.ball_index], spec.samples_before),
+            _arc_length_samples(spline, knots[spec.ball_index], knots[-1], spec.samples_after),
+        )
+    )
+    start = Rotation.identity()
+    start = _align(_align(start, np.array([1.0, 0.0, 0.0])), tangent(knots[0]))
+    tip_start = points[0]
+    com_start = tip_start - start.apply(TIP)
+    goals: list[dict[str, Any]] = []
+    previous = start
+    pierce = spec.samples_before - 1
+    for j, s in enumerate(params):
+        orientation = _align(previous, tangent(s))
+        goal: dict[str, Any] = {"point": list(TIP)}
+        if j == pierce:
+            goal["nail"] = {"prop": f"ball_{spec.name[4:]}"}
+            goal["time"] = PIERCE_TIME
+        else:
+            goal["nail"] = _vec(spline(s))
+        if j == len(params) - 1:
+            goal["time"] = spec.hit_time
+        if j == spec.somersault_sample:
+            turn = (orientation * previous.inv()).as_rotvec()
+            angle = float(np.linalg.norm(turn))
+            axis = turn / angle if angle > 1e-9 else np.cross(tangent(s), [0.0, 0.0, 1.0])
+            axis = axis / np.linalg.norm(axis)
+            goal["relative_rotation"] = _vec(turn + 2.0 * math.pi * axis)
+        else:
+            goal["orientation"] = _quat(orientation)
+        goals.append(goal)
+        previous = orientation
+    hit = spline(knots[-1])
+    direction = tangent(knots[-1]) / np.linalg.norm(tangent(knots[-1]))
+    embed = hit + direction * (EMBED_DEPTH / direction[0])
+    goals.append(
+        {
+            "point": list(TIP),
+            "nail": _vec(embed),
+            "orientation": _quat(previous),
+            "time": round(spec.hit_time + EMBED_DURATION, 12),
+        }
+    )
+    body = {
+        "name": spec.name,
+        "shape": "rod",
+        "size": [ROD_LENGTH, ROD_RADIUS],
+        "mass": ROD_MASS,
+        "color": list(spec.color),
+        "position": _vec(com_start),
+        "orientation": _quat(start),
+        "force_limit": FORCE_LIMIT,
+        "torque_limit": TORQUE_LIMIT,
+        "end_velocity": [0.0, 0.0, 0.0],
+        "end_angular_velocity": [0.0, 0.0, 0.0],
+        "collisions": False,
+        "goals": goals,
+    }
+    ball_at_pierce = points[spec.ball_index]
+    velocity = np.asarray(spec.ball_velocity)
+    ball = {
+        "name": f"ball_{spec.name[4:]}",
+        "shape": "sphere",
+        "size": [BALL_RADIUS],
+        "color": [0.85, 0.08, 0.08, 1.0],
+        "position": _vec(ball_at_pierce - velocity * PIERCE_TIME),
+        "velocity": _vec(velocity),
+        "collisions": False,
+    }
+    return body, ball
+
+
+def build_three_rods() -> dict[str, Any]:
+    """The three-rod scenario as YAML-ready data."""
+    bodies, props = [], []
+    for spec in ROD_SPECS:
+        body, ball = _rod(spec)
+        bodies.append(body)
+        props.append(ball)
+    props.append(
+        {
+            "name": "target",
+            "shape": "box",
+            "size": list(TARGET_HALF_EXTENTS),
+            "color": [0.93, 0.93, 0.9, 1.0],
+            "position": list(TARGET_CENTER),
+            "collisions": False,
+        }
+    )
+    return {
+        "name": "three_rods",
+        "control_frequency": 60,
+        "margin": 0.5,
+        "workspace": {"low": [-12.0, -10.0, -1.0], "high": [12.0, 10.0, 12.0]},
+        "bodies": bodies,
+        "props": props,
+    }
+
+
+def write_three_rods_yaml(path: Path = YAML_PATH) -> Path:
+    header = (
+        "# The paper's three-rod demo (Plates 1-8). Generated by `python -m sgc_env.three_rods`\n"
+        "# from the path functions in sgc_env/three_rods.py: edit those, not this file.\n"
+    )
+    path.write_text(header + yaml.safe_dump(build_three_rods(), sort_keys=False, width=100))
+    return path
+
+
+if __name__ == "__main__":
+    print(write_three_rods_yaml())

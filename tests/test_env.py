@@ -1,0 +1,318 @@
+"""The environments: checkers, determinism, vectorisation, pickling, physics facts, contracts."""
+
+from __future__ import annotations
+
+import math
+import pickle
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import sgc_env
+from sgc_env.envs import SGCEnv
+from sgc_env.scenario import Body, Goal, Scenario, load_scenario
+
+
+def rollout(env: gym.Env, seed: int, steps: int) -> list[np.ndarray]:
+    obs, _ = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    out = [obs]
+    for _ in range(steps):
+        obs, reward, terminated, truncated, _ = env.step(env.action_space.sample())
+        out.append(np.append(obs, reward))
+        if terminated or truncated:
+            obs, _ = env.reset()
+            out.append(obs)
+    return out
+
+
+@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)
+def test_checkers_pass_with_warnings_as_errors(env_id):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = gym.make(env_id)
+        check_env(env.unwrapped)
+        env.close()
+        env = gym.make(env_id)
+        sb3_check_env(env.unwrapped)
+        env.close()
+
+
+@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0", "SGCThreeRods-v0"])
+def test_same_seed_same_rollout_bitwise(env_id):
+    a, b = gym.make(env_id), gym.make(env_id)
+    ra, rb = rollout(a, 7, 150), rollout(b, 7, 150)
+    assert len(ra) == len(rb)
+    for x, y in zip(ra, rb, strict=True):
+        assert x.tobytes() == y.tobytes()
+
+
+def test_seeded_then_plain_reset_is_deterministic():
+    a, b = gym.make("SGCPoint-v0"), gym.make("SGCPoint-v0")
+    a.reset(seed=11)
+    b.reset(seed=11)
+    oa, _ = a.reset()
+    ob, _ = b.reset()
+    assert oa.tobytes() == ob.tobytes()
+    assert a.unwrapped.scenario == b.unwrapped.scenario
+
+
+def test_random_scenario_changes_with_reset():
+    env = gym.make("SGCPoint-v0")
+    env.reset(seed=1)
+    first = env.unwrapped.scenario
+    env.reset()
+    assert env.unwrapped.scenario != first
+    # the action scale is not observed, so it must stay fixed between episodes
+    assert env.unwrapped.scenario.bodies[0].force_limit == first.bodies[0].force_limit
+
+
+@pytest.mark.parametrize("mode", ["sync", "async"])
+def test_make_vec(mode):
+    envs = gym.make_vec("SGCRod-v0", num_envs=2, vectorization_mode=mode)
+    obs, _ = envs.reset(seed=3)
+    assert obs.shape == (2, envs.single_observation_space.shape[0])
+    for _ in range(5):
+        obs, reward, term, trunc, info = envs.step(envs.action_space.sample())
+    assert obs.dtype == np.float32 and reward.shape == (2,)
+    envs.close()
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])
+def test_pickle_continues_identically(env_id):
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=5)
+    env.action_space.seed(5)
+    for _ in range(10):
+        env.step(env.action_space.sample())
+    clone = pickle.loads(pickle.dumps(env))
+    actions = [env.action_space.sample() for _ in range(20)]
+    for a in actions:
+        o1, r1, *_ = env.step(a)
+        o2, r2, *_ = clone.step(a)
+        if isinstance(o1, dict):
+            o1, o2 = np.concatenate(list(o1.values())), np.concatenate(list(o2.values()))
+        assert o1.tobytes() == o2.tobytes() and r1 == r2
+    env.reset()
+    clone.reset()
+    assert env.unwrapped.scenario == clone.unwrapped.scenario
+    clone.close()
+
+
+def test_save_restore_state():
+    env = gym.make("SGCRod-v0").unwrapped
+    env.reset(seed=2)
+    env.action_space.seed(2)
+    for _ in range(5):
+        env.step(env.action_space.sample() * 0.1)
+    saved = env.save_state()
+    actions = [env.action_space.sample() * 0.1 for _ in range(40)]
+    first = [env.step(a)[0] for a in actions]
+    env.restore_state(saved)
+    second = [env.step(a)[0] for a in actions]
+    for x, y in zip(first, second, strict=True):
+        assert x.tobytes() == y.tobytes()
+
+
+def coasting_scenario(velocity=(1.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0), shape="sphere"):
+    size = (0.05,) if shape == "sphere" else (0.6, 0.03)
+    body = Body(
+        "b", shape=shape, size=size, position=(0.0, 0.0, 1.0), linear_velocity=velocity,
+        angular_velocity=angular, goals=(Goal(nail=(1.0, 0.0, 1.0), time=1.0),),
+    )  # fmt: skip
+    return Scenario(bodies=(body,), gravity=(0.0, 0.0, 0.0), margin=0.0)
+
+
+def test_damping_is_off_body_coasts_at_constant_speed():
+    env = SGCEnv(coasting_scenario(angular=(0.0, 0.0, 3.0), shape="rod"))
+    env.reset()
+    for _ in range(60):
+        _, _, terminated, truncated, info = env.step(np.zeros(6, np.float32))
+    assert info["time"] == pytest.approx(1.0)
+    assert info["body_velocity"][0].tolist() == [1.0, 0.0, 0.0]
+    assert info["body_angular_velocity"][0].tolist() == [0.0, 0.0, 3.0]
+    assert info["body_position"][0][0] == pytest.approx(1.0, abs=1e-12)
+    assert truncated and not terminated
+
+
+def test_force_acts_at_centre_of_mass_without_spin():
+    env = SGCEnv(coasting_scenario(velocity=(0.3, -0.2, 0.1), shape="rod"))
+    env.reset()
+    for _ in range(30):
+        _, _, _, _, info = env.step(np.array([0.5, -0.3, 0.8, 0, 0, 0], np.float32))
+    assert np.max(np.abs(info["body_angular_velocity"])) < 1e-12
+
+
+def test_gravity_is_on_by_default_and_not_compensated():
+    s = load_scenario("point_three_goals")
+    env = SGCEnv(s)
+    env.reset()
+    _, _, _, _, info = env.step(np.zeros(3, np.float32))
+    assert info["body_velocity"][0][2] == pytest.approx(-9.81 / 60)
+
+
+def test_control_frequency_must_divide_sim_frequency():
+    with pytest.raises(ValueError, match="integer multiple"):
+        SGCEnv("point_three_goals", control_frequency=70)
+    env = SGCEnv("point_three_goals", control_frequency=120)
+    assert env.substeps == 2
+
+
+def test_observation_contract_fields():
+    env = SGCEnv("rod_basic")
+    obs, info = env.reset()
+    lay = env.layout
+    assert obs.shape == (lay.size,) and obs.dtype == np.float32
+    s = env.scenario
+    nail = np.array(s.bodies[0].goals[0].nail)
+    point = np.array(info["point_position"][0])
+    np.testing.assert_allclose(
+        obs[lay.body_slice(0, "position_deviation")], point - nail, atol=1e-6
+    )
+    np.testing.assert_allclose(obs[lay.body_slice(0, "point_offset")], [0, 0, 0.3], atol=1e-7)
+    assert obs[lay.body_slice(0, "position_time_left")][0] == pytest.approx(0.5)
+    assert obs[lay.body_slice(0, "position_course_duration")][0] == pytest.approx(0.5)
+    np.testing.assert_allclose(
+        obs[lay.body_slice(0, "position_next_start")],
+        nail - np.array(s.bodies[0].goals[1].nail),
+        atol=1e-6,
+    )
+    assert obs[lay.body_slice(0, "position_flags")].tolist() == [1.0, 0.0]
+    assert obs[lay.body_slice(0, "orientation_flags")].tolist() == [1.0, 0.0]
+    assert obs[lay.global_slice("time")][0] == 0.0
+
+
+def test_goal_ticks_advance_goals_and_report_errors():
+    env = SGCEnv("point_three_goals")
+    obs, _ = env.reset()
+    lay = env.layout
+    events = []
+    steps = 0
+    truncated = False
+    while not truncated:
+        obs, _, terminated, truncated, info = env.step(np.array([0, 0, 9.81 / 60], np.float32))
+        steps += 1
+        events += info.get("goal_reached", [])
+        assert not terminated
+    assert steps == 90 + 15  # last goal at 1.5 s, margin 0.25 s, 60 Hz
+    assert [e["goal"] for e in events] == [0, 1, 2]
+    assert [round(e["time"] * 60) for e in events] == [30, 58, 90]
+    assert all(e["orientation_error"] is None and e["position_error"] > 0 for e in events)
+    assert obs[lay.body_slice(0, "position_flags")].tolist() == [1.0, 1.0]
+    assert obs[lay.body_slice(0, "position_time_left")][0] == pytest.approx(-0.25, abs=1e-6)
+    end_v = obs[lay.body_slice(0, "position_end_velocity")]
+    g = env.scenario.bodies[0].goals
+    expected = (np.array(g[2].nail) - np.array(g[1].nail)) / (g[2].time - g[1].time)
+    np.testing.assert_allclose(end_v, expected, rtol=1e-6)
+
+
+def test_somersault_deviation_is_unwrapped_beyond_pi():
+    rel = (2.0 * math.pi, 0.0, 0.0)
+    body = Body(
+        "rod", shape="rod", size=(0.6, 0.03), position=(0.0, 0.0, 1.0),
+        angular_velocity=(2.0 * math.pi, 0.0, 0.0),
+        goals=(Goal(relative_rotation=rel, time=1.0),),
+    )  # fmt: skip
+    env = SGCEnv(Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0))
+    obs, _ = env.reset()
+    sl = env.layout.body_slice(0, "orientation_deviation")
+    np.testing.assert_allclose(obs[sl], [-2 * math.pi, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(
+        obs[env.layout.body_slice(0, "orientation_course_start")], [-2 * math.pi, 0, 0]
+    )
+    history = []
+    for _ in range(60):
+        obs, *_, info = env.step(np.zeros(6, np.float32))
+        history.append(obs[sl][0])
+    # coasting at 2 pi rad/s for 1 s completes the somersault: phi goes -2pi -> 0 smoothly
+    assert np.all(np.diff(history) > 0)
+    assert info["goal_reached"][0]["orientation_error"] < 1e-6
+
+
+def test_workspace_exit_terminates():
+    body = Body("b", position=(0.0, 0.0, 0.0), linear_velocity=(30.0, 0.0, 0.0),
+                goals=(Goal(nail=(0.5, 0.0, 0.0), time=1.0),))  # fmt: skip
+    s = Scenario(bodies=(body,), gravity=(0, 0, 0), workspace=((-1, -1, -1), (1, 1, 1)))
+    env = SGCEnv(s)
+    env.reset()
+    for _ in range(10):
+        _, _, terminated, truncated, _ = env.step(np.zeros(3, np.float32))
+        if terminated:
+            break
+    assert terminated and not truncated
+
+
+def test_scenario_swap_via_reset_options():
+    env = SGCEnv("point_three_goals")
+    env.reset(options={"scenario": "intercept"})
+    assert env.scenario.name == "intercept"
+    assert env.scenario.props[0].name == "fish"
+    with pytest.raises(ValueError, match="bodies"):
+        env.reset(options={"scenario": "three_rods"})
+
+
+def test_intercept_target_moves_kinematically():
+    env = SGCEnv("intercept")
+    env.reset()
+    uid = env.sim.bodies["fish"].uid
+    for _ in range(60):
+        env.step(np.zeros(3, np.float32))
+    pos = sgc_env.simulator.pybullet.getBasePositionAndOrientation(
+        uid, physicsClientId=env.sim.client
+    )[0]
+    np.testing.assert_allclose(pos, env.scenario.props[0].position_at(1.0), atol=1e-12)
+
+
+def test_goal_env_compute_reward_is_vectorised():
+    env = gym.make("SGCPointGoal-v0").unwrapped
+    obs, _ = env.reset(seed=0)
+    a = np.stack([obs["desired_goal"], obs["achieved_goal"]])
+    d = np.stack([obs["desired_goal"], obs["desired_goal"]])
+    assert env.compute_reward(a, d, [{}, {}]).tolist() == [0.0, -1.0]
+
+
+def test_goal_env_with_her():
+    from stable_baselines3 import SAC, HerReplayBuffer
+
+    env = gym.make("SGCPointGoal-v0")
+    model = SAC(
+        "MultiInputPolicy", env, replay_buffer_class=HerReplayBuffer, learning_starts=300,
+        batch_size=32,
+        policy_kwargs={"net_arch": [16]}, seed=0,
+    )  # fmt: skip
+    model.learn(330)
+
+
+def test_close_disconnects():
+    env = SGCEnv("point_three_goals")
+    client = env.sim.client
+    env.close()
+    assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+
+
+def test_spin_clamp_is_flagged_not_terminal():
+    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), shape="rod"))
+    env.reset()
+    _, _, terminated, _, info = env.step(np.array([0, 0, 0, 0, 0, 1], np.float32))
+    assert info["spin_clamped"] and not terminated
+
+
+def test_goals_of_every_body_are_reported_when_another_body_is_done():
+    a = Body("a", position=(0.0, 0.0, 1.0), goals=(Goal(nail=(0.1, 0.0, 1.0), time=0.5),))
+    b = Body(
+        "b", position=(0.0, 1.0, 1.0),
+        goals=(Goal(nail=(0.1, 1.0, 1.0), time=0.25), Goal(nail=(0.2, 1.0, 1.0), time=1.0)),
+    )  # fmt: skip
+    env = SGCEnv(Scenario(bodies=(a, b), gravity=(0, 0, 0), margin=0.0))
+    env.reset()
+    events, truncated = [], False
+    while not truncated:
+        _, _, _, truncated, info = env.step(np.zeros(6, np.float32))
+        events += [
+            (e["body"], e["goal"], round(e["time"] * 60)) for e in info.get("goal_reached", [])
+        ]
+    assert events == [(1, 0, 15), (0, 0, 30), (1, 1, 60)]
