@@ -142,41 +142,50 @@ def torque_for_orientation(
 ) -> tuple[float, float, float]:
     """World torque, held ``n`` substeps, that lands the body on ``target``.
 
-    The first guess is closed form: treat the substep rotations as commuting, so the end
-    rotation is ``n h w + h^2 n (n + 1) / 2 * alpha``, and add the gyroscopic term at the
-    current state (``tau = Iw alpha + w x Iw w``). That is what the expert uses between goals
-    (``exact=False``, a few microseconds). With ``exact=True`` a Newton iteration on the
-    simulated model, with finite-difference Jacobians, removes what the first guess
-    ignores, down to floating point: used on the tick that reaches a goal.
+    Linear model: substep ``j`` (0-based) accelerates at ``Iw_j^-1 (tau - w x Iw_j w)`` and that
+    acceleration moves the end rotation by ``h^2 (n - j)`` times itself, with ``Iw_j`` taken
+    along the predicted free rotation. Summing gives ``A tau = b`` with
+    ``A = h^2 sum_j (n - j) Iw_j^-1``: a thin rod's axial inertia makes ``A`` very anisotropic,
+    and the body turning during the period mixes its directions, which a single inertia at the
+    start of the period gets badly wrong. One correction step on the simulated model, with
+    ``A`` as the Jacobian, follows (``exact=False``: between goals). With ``exact=True`` the
+    correction repeats, switching to finite-difference Jacobians if it stalls, until the
+    residual rotation is below ``tolerance`` (goal ticks).
     """
     w = (float(angular_velocity[0]), float(angular_velocity[1]), float(angular_velocity[2]))
-    # The held world torque acts through Iw^-1 at orientations that turn during the period, and
-    # a thin rod's axis term is far more sensitive than the others. Substep j (orientation at
-    # (j - 1) h) moves the end rotation with weight n - j + 1, so the weighted mean orientation
-    # is the one reached at (n - 1) h / 3: use the inertia there.
-    midway = (n - 1) * h / 3.0
-    turn = _quat_exp(midway * w[0], midway * w[1], midway * w[2])
-    rm = _rotation_matrix(_quat_mul(turn, orientation))
-    gain = 2.0 / (h * h * n * (n + 1))
     needed = _quat_log(_quat_mul(target, _conjugate(orientation)))
-    alpha = tuple((needed[i] - n * h * w[i]) * gain for i in range(3))
-    iw_alpha = _world_inertia_apply(rm, inertia, alpha, inverse=False)
-    iw_w = _world_inertia_apply(rm, inertia, w, inverse=False)
-    gyro = _cross(w, iw_w)
-    torque = np.array([iw_alpha[i] + gyro[i] for i in range(3)])
-    if not exact:
-        return (float(torque[0]), float(torque[1]), float(torque[2]))
+    step_turn = _quat_exp(h * w[0], h * w[1], h * w[2])
+    a_matrix = np.zeros((3, 3))
+    gyro_term = np.zeros(3)
+    q = tuple(float(c) for c in orientation)
+    inv_inertia = np.array([1.0 / inertia[0], 1.0 / inertia[1], 1.0 / inertia[2]])
+    w_arr = np.array(w)
+    for j in range(n):
+        rm = np.array(_rotation_matrix(q))
+        inv_world = (rm * inv_inertia) @ rm.T
+        world = (rm * np.asarray(inertia, dtype=float)) @ rm.T
+        weight = h * h * (n - j)
+        a_matrix += weight * inv_world
+        gyro_term += weight * (inv_world @ np.cross(w_arr, world @ w_arr))
+        q = _quat_mul(step_turn, q)
+    b = np.array(needed) - n * h * w_arr + gyro_term
+    torque = np.linalg.solve(a_matrix, b)
 
     def residual(tau: np.ndarray) -> np.ndarray:
         reached, _ = simulate_rotation(orientation, w, tau, inertia, h, n)
         return np.array(rotation_residual(reached, target))
 
     r = residual(torque)
-    for _ in range(max_iterations):
+    iterations = max_iterations if exact else 1
+    for i in range(iterations):
         if float(np.max(np.abs(r))) <= tolerance:
             break
-        torque = torque - np.linalg.solve(_residual_jacobian(residual, torque, r), r)
+        previous = float(np.max(np.abs(r)))
+        jacobian = a_matrix if i < 2 else _residual_jacobian(residual, torque, r)
+        torque = torque - np.linalg.solve(jacobian, r)
         r = residual(torque)
+        if i >= 2 and float(np.max(np.abs(r))) >= previous:
+            break
     return (float(torque[0]), float(torque[1]), float(torque[2]))
 
 

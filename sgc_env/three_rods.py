@@ -30,8 +30,8 @@ ROD_MASS = 1.0
 TIP = (0.0, 0.0, ROD_LENGTH / 2)
 BALL_RADIUS = 0.22
 PIERCE_TIME = 1.2
-EMBED_DEPTH = 0.12
-EMBED_DURATION = 0.1
+EMBED_DEPTH = 0.2
+EMBED_DURATION = 0.15
 TARGET_FACE_X = 7.9
 TARGET_CENTER = (8.0, 0.0, 3.2)
 TARGET_HALF_EXTENTS = (0.1, 3.0, 2.2)
@@ -60,6 +60,8 @@ class RodSpec:
     hit_time: float
     ball_velocity: tuple[float, float, float]
     somersault_sample: int | None = None
+    somersault_weight: float = 0.3
+    """Routing weight of the somersault's course: the rod slows down to turn over."""
 
     @property
     def goal_count(self) -> int:
@@ -182,6 +184,7 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
             axis = turn / angle if angle > 1e-9 else np.cross(tangent(s), [0.0, 0.0, 1.0])
             axis = axis / np.linalg.norm(axis)
             goal["relative_rotation"] = _vec(turn + 2.0 * math.pi * axis)
+            goal["weight"] = spec.somersault_weight
         else:
             goal["orientation"] = _quat(orientation)
         goals.append(goal)

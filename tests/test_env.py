@@ -210,27 +210,43 @@ def test_goal_ticks_advance_goals_and_report_errors():
     np.testing.assert_allclose(end_v, expected, rtol=1e-6)
 
 
-def test_somersault_deviation_is_unwrapped_beyond_pi():
-    rel = (2.0 * math.pi, 0.0, 0.0)
+def _somersault_env(time: float) -> SGCEnv:
     body = Body(
         "rod", shape="rod", size=(0.6, 0.03), position=(0.0, 0.0, 1.0),
         angular_velocity=(2.0 * math.pi, 0.0, 0.0),
-        goals=(Goal(relative_rotation=rel, time=1.0),),
+        goals=(Goal(relative_rotation=(2.0 * math.pi, 0.0, 0.0), time=time),),
     )  # fmt: skip
-    env = SGCEnv(Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0))
+    return SGCEnv(Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0))
+
+
+def test_somersault_is_split_into_courses_tracked_continuously():
+    # A deviation of 2 pi sits on the singular shell of the rotation vector, so the env splits
+    # the somersault into three 2 pi / 3 courses; the rotation still left (phi plus the
+    # courses not started yet) must fall smoothly from -2 pi to 0.
+    env = _somersault_env(1.0)
     obs, _ = env.reset()
     sl = env.layout.body_slice(0, "orientation_deviation")
-    np.testing.assert_allclose(obs[sl], [-2 * math.pi, 0, 0], atol=1e-6)
+    piece = -2.0 * math.pi / 3.0
+    np.testing.assert_allclose(obs[sl], [piece, 0, 0], atol=1e-6)
     np.testing.assert_allclose(
-        obs[env.layout.body_slice(0, "orientation_course_start")], [-2 * math.pi, 0, 0]
+        obs[env.layout.body_slice(0, "orientation_course_start")], [piece, 0, 0], rtol=1e-6
     )
-    history = []
-    for _ in range(60):
+    remaining, events = [], []
+    for k in range(60):
         obs, *_, info = env.step(np.zeros(6, np.float32))
-        history.append(obs[sl][0])
-    # coasting at 2 pi rad/s for 1 s completes the somersault: phi goes -2pi -> 0 smoothly
-    assert np.all(np.diff(history) > 0)
-    assert info["goal_reached"][0]["orientation_error"] < 1e-6
+        courses_left = 2 - min(2, (k + 1) // 20)
+        remaining.append(obs[sl][0] + courses_left * piece)
+        events += info.get("goal_reached", [])
+    # coasting at 2 pi rad/s for 1 s completes the somersault
+    assert np.all(np.diff(remaining) > 0)
+    assert remaining[-1] == pytest.approx(0.0, abs=1e-6)
+    assert [e["goal"] for e in events] == [0]
+    assert events[0]["orientation_error"] < 1e-6
+
+
+def test_somersault_without_enough_ticks_is_rejected():
+    with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
+        _somersault_env(2.0 / 60.0)
 
 
 def test_workspace_exit_terminates():

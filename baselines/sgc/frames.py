@@ -193,6 +193,21 @@ _NAN3 = (math.nan, math.nan, math.nan)
 _ZERO3 = (0.0, 0.0, 0.0)
 
 
+DWELL_TOLERANCE = 1e-9
+"""A next course shorter than this fraction of the current one is a dwell (repeated goal).
+
+Goals that repeat a nail or an orientation often differ by rounding (a rotation composed with
+its inverse is ~1e-16 from the identity); treated as a real course, that next course would be
+1e16 times slower and drive ``k`` to ~1e-16, a profile that stops dead at the course start.
+"""
+
+
+def _negligible(nxt: tuple[float, float, float], d: tuple[float, float, float]) -> bool:
+    n2 = nxt[0] * nxt[0] + nxt[1] * nxt[1] + nxt[2] * nxt[2]
+    d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    return n2 <= (DWELL_TOLERANCE * DWELL_TOLERANCE) * d2
+
+
 def course_end_velocity(
     d_start,
     d_next,
@@ -224,7 +239,7 @@ def course_end_velocity(
     if not (math.isfinite(t_course) and t_course > 0.0):
         raise ValueError(f"t_course must be finite and > 0, got {t_course!r}")
     nxt = None if d_next is None else _vec3(d_next, "d_next")
-    if nxt is not None and nxt == _ZERO3:
+    if nxt is not None and _negligible(nxt, d):
         nxt = "rest"
     elif nxt is not None and (t_next is None or not (math.isfinite(t_next) and t_next > 0.0)):
         raise ValueError(f"t_next must be finite and > 0, got {t_next!r}")

@@ -563,10 +563,11 @@ class SGCEnv(gym.Env):
                 k = self._ori_idx[i]
                 phi = self._phi[i]
                 g = int(to.goal_ids[k])
-                ev = hits.setdefault(
-                    g, {"body": i, "goal": g, "time": tick * self.dt, "position_error": None}
-                )
-                ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+                if not to.via[k]:
+                    ev = hits.setdefault(
+                        g, {"body": i, "goal": g, "time": tick * self.dt, "position_error": None}
+                    )
+                    ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
                 if k < to.size - 1:
                     self._ori_idx[i] = k + 1
                     start = to.course_start[k + 1]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -121,6 +121,7 @@ class Track:
     next_start: np.ndarray  # (m, 3); zeros for the last
     next_duration: np.ndarray  # (m,)
     end_velocity: np.ndarray  # (3,)
+    via: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))  # inserted sub-goals
 
     @property
     def size(self) -> int:
@@ -131,14 +132,6 @@ class Track:
 class BodyTracks:
     position: Track | None
     orientation: Track | None
-
-
-def _empty(n_target: int) -> Track:
-    z = np.zeros((0, 3))
-    return Track(
-        np.zeros(0, int), np.zeros(0, int), np.zeros(0), np.zeros((0, n_target)), z, z, np.zeros(0),
-        z, np.zeros(0), np.zeros(3),
-    )  # fmt: skip
 
 
 def _finish(track: Track) -> Track:
@@ -174,32 +167,65 @@ def _position_track(body: Body, freq: int) -> Track | None:
     return _finish(track)
 
 
+MAX_COURSE_ROTATION = 2.0 * math.pi / 3.0
+"""Longest rotation one orientation course may make; longer relative rotations are split.
+
+A rotation-vector deviation is singular on the shell |phi| = 2 pi (every rotation near the
+identity has a representative there only along one axis), so a somersault given as one
+relative rotation of 2 pi or more cannot be tracked through it from measured states. The env
+splits such a goal into equal sub-rotations about the same axis, timed evenly on the control
+grid, each one a course of its own; only the last reports a goal event.
+"""
+
+
+def _pieces(rel: Sequence[float], t0: float, t1: float, freq: int, where: str):
+    """Equal sub-rotations of ``rel`` with their times on the control grid."""
+    angle = math.sqrt(sum(c * c for c in rel))
+    m = max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
+    k0, k1 = round(t0 * freq), round(t1 * freq)
+    if k1 - k0 < m:
+        raise ValueError(
+            f"{where}: a relative rotation of {angle:.6g} rad is split into {m} courses of at "
+            f"most {MAX_COURSE_ROTATION:.4g} rad, which needs {m} control ticks before the goal "
+            f"time but only {k1 - k0} are left; give the goal more time"
+        )
+    step = tuple(c / m for c in rel)
+    return [(step, (k0 + round(i * (k1 - k0) / m)) / freq, i == m) for i in range(1, m + 1)]
+
+
 def _orientation_track(body: Body, freq: int) -> Track | None:
     ids = [j for j, g in enumerate(body.goals) if g.has_orientation]
     if not ids:
         return None
-    quats, starts = [], []
+    goal_ids, quats, starts, times, via = [], [], [], [], []
     prev_q = tuple(body.orientation)
+    prev_t = 0.0
     for j in ids:
         g = body.goals[j]
+        t = float(g.time)  # type: ignore[arg-type]
         if g.relative_rotation is not None:
             rel = tuple(float(x) for x in g.relative_rotation)
-            q = quat_mul(quat_from_rotvec(rel), prev_q)
-            start = (-rel[0], -rel[1], -rel[2])
+            pieces = _pieces(rel, prev_t, t, freq, f"{body.name}.goals[{j}]")
         else:
             q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
-            start = rotvec_from_quat(quat_conj_mul(prev_q, q))
-        quats.append(q)
-        starts.append(start)
-        prev_q = q
-    times = np.array([float(body.goals[j].time) for j in ids])  # type: ignore[arg-type]
+            pieces = [(rotvec_from_quat(quat_conj_mul(q, prev_q)), t, True)]
+        for step, t_piece, last in pieces:
+            prev_q = quat_mul(quat_from_rotvec(step), prev_q) if g.relative_rotation else q
+            goal_ids.append(j)
+            quats.append(prev_q)
+            starts.append((-step[0], -step[1], -step[2]))
+            times.append(t_piece)
+            via.append(not last)
+        prev_t = t
     end_w = (
         np.zeros(3) if body.end_angular_velocity is None else np.asarray(body.end_angular_velocity)
     )
+    times_arr = np.array(times)
     track = Track(
-        np.array(ids), np.rint(times * freq).astype(int), times, np.array(quats),
-        np.zeros((len(ids), 3)),
+        np.array(goal_ids), np.rint(times_arr * freq).astype(int), times_arr, np.array(quats),
+        np.zeros((len(goal_ids), 3)),
         np.array(starts, float), np.zeros(0), np.zeros(0), np.zeros(0), end_w.astype(float),
+        np.array(via, bool),
     )  # fmt: skip
     return _finish(track)
 
