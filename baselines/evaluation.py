@@ -131,16 +131,20 @@ def run_episode(
     keep_infos: bool = False,
     max_steps: int = 100_000,
     frames: list[np.ndarray] | None = None,
+    on_step: Callable[[gym.Env, int, Mapping[str, Any]], None] | None = None,
 ) -> EpisodeRecord:
     """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
 
     ``frames``: a list to append ``env.render()`` to after the reset and every step (for
-    videos; the env needs ``render_mode="rgb_array"``).
+    videos; the env needs ``render_mode="rgb_array"``). ``on_step(env, step, info)`` is called
+    after the reset (step 0) and after every step, for progress bars and custom rendering.
     """
     started = time.perf_counter()
     obs, initial_info = env.reset(seed=seed)
     if frames is not None:
         frames.append(env.render())
+    if on_step is not None:
+        on_step(env, 0, initial_info)
     infos: list[dict[str, Any]] = []
     state, total, terminated = None, 0.0, False
     first = True
@@ -154,6 +158,8 @@ def run_episode(
         total += float(reward)
         if frames is not None:
             frames.append(env.render())
+        if on_step is not None:
+            on_step(env, len(infos), info)
         if terminated or truncated:
             break
     base = env.unwrapped

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 __all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
 
 ROD_LENGTH = 1.0
-ROD_RADIUS = 0.025
+ROD_RADIUS = 0.04
 ROD_MASS = 1.0
 TIP = (0.0, 0.0, ROD_LENGTH / 2)
 BALL_RADIUS = 0.22

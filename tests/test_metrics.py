@@ -451,3 +451,24 @@ def test_goals_after_the_rollout_ended_fail_with_nan_errors():
     assert card["met"] == [True, False, False]
     assert card["goals_after_end"] == 2
     assert [math.isnan(r["position_error"]) for r in card["position_goals"]] == [False, True, True]
+
+
+def test_closest_approach_on_segments_is_exact_at_a_hit_with_a_speed_change():
+    # Through the nail on the tick at t = 0.5, fast before and slow after: a parabola through
+    # the squared distances would put the vertex ~0.3 ticks late; the segments do not.
+    times = np.arange(11) / 10.0
+    offsets = np.where((times < 0.5)[:, None], [[4.0, 0.0, 0.0]], [[1.0, 0.0, 0.0]]) * (
+        times[:, None] - 0.5
+    )
+    t_close, d_close = closest_approach(times, offsets, 0.0, 1.0)
+    assert t_close == 0.5 and d_close == 0.0
+    t_scalar, _ = closest_approach(times, np.linalg.norm(offsets, axis=1), 0.0, 1.0)
+    assert t_scalar != 0.5
+
+
+def test_closest_approach_on_segments_between_ticks():
+    times = np.arange(11) / 10.0
+    offsets = np.stack([times - 0.537, np.full_like(times, 0.01), np.zeros_like(times)], axis=1)
+    t_close, d_close = closest_approach(times, offsets, 0.2, 0.8)
+    assert t_close == pytest.approx(0.537, abs=1e-12)
+    assert d_close == pytest.approx(0.01, abs=1e-12)

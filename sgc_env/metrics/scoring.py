@@ -74,7 +74,7 @@ def _position_goal_metrics(
         speed = float(np.linalg.norm(sg.interpolate_at(traj.times, vel, goal.time)))
         if _after_end(traj, goal):
             error = speed = math.nan
-        t_close, d_close = sg.closest_approach(traj.times, dist, lo, hi)
+        t_close, d_close = sg.closest_approach(traj.times, pos - nail, lo, hi)
         t_entry = sg.first_entry(traj.times, dist, tol.position, lo, hi)
         start = (
             sg.interpolate_at(traj.times, pos, previous_time)

@@ -89,16 +89,24 @@ def interpolate_at(times: ArrayLike, values: ArrayLike, t: float) -> FloatArray:
 def closest_approach(
     times: ArrayLike, distance: ArrayLike, t_start: float, t_end: float
 ) -> tuple[float, float]:
-    """Time and value of the smallest `distance` within [t_start, t_end], refined sub-tick.
+    """Time and value of the closest approach within [t_start, t_end], refined sub-tick.
 
-    A parabola is fitted to the *squared* distance at the best sample and its two neighbours
-    (squared distance is exactly quadratic in time for straight-line motion past a point, while
-    the distance itself has a kink at an exact hit). The vertex is kept only if it lies between
-    the neighbours and inside the window; otherwise the best sample is returned.
+    ``distance`` is either the offsets from the target, shape (n, k), or scalar distances,
+    shape (n,). Offsets are refined on the straight segments between samples (the linear
+    interpolation that :func:`interpolate_at` also uses): exact at an exact hit on a tick
+    whatever the speeds before and after it, and exact for straight-line motion between
+    ticks. Scalar distances fall back to a parabola through the squared distance at the best
+    sample and its two neighbours, kept only if its vertex lies between them and inside the
+    window; that one is biased by up to half a tick when the speed changes at the goal.
     Returns (nan, nan) if no sample lies in the window.
     """
     ts = check_times(times)
-    d = as_finite_array(distance, "distance", ndim=1)
+    values = np.asarray(distance, dtype=float)
+    if values.ndim == 2:
+        offsets = as_finite_array(values, "distance", ndim=2)
+        _check_same_length(ts, offsets, "distance")
+        return _closest_on_segments(ts, offsets, t_start, t_end)
+    d = as_finite_array(values, "distance", ndim=1)
     _check_same_length(ts, d, "distance")
     if not t_end >= t_start:
         raise ValueError(f"t_end ({t_end}) must not precede t_start ({t_start})")
@@ -119,6 +127,30 @@ def closest_approach(
         return best_t, best_d
     value = float(np.polyval(coeffs, vertex - ts[k]))
     return float(vertex), math.sqrt(max(value, 0.0))
+
+
+def _closest_on_segments(
+    ts: FloatArray, offsets: FloatArray, t_start: float, t_end: float
+) -> tuple[float, float]:
+    """Closest approach of the polyline through ``offsets`` to the origin, inside the window."""
+    if not t_end >= t_start:
+        raise ValueError(f"t_end ({t_end}) must not precede t_start ({t_start})")
+    inside = in_window(ts, t_start, t_end)
+    if inside.size == 0:
+        return math.nan, math.nan
+    lo, hi = int(inside[0]), int(inside[-1])
+    a, b = offsets[lo:hi], offsets[lo + 1 : hi + 1]
+    if a.shape[0] == 0:
+        return float(ts[lo]), float(np.linalg.norm(offsets[lo]))
+    step = b - a
+    length2 = np.einsum("ij,ij->i", step, step)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = np.where(length2 > 0.0, -np.einsum("ij,ij->i", a, step) / length2, 0.0)
+    s = np.clip(s, 0.0, 1.0)
+    nearest = a + s[:, None] * step
+    d = np.linalg.norm(nearest, axis=1)
+    k = int(np.argmin(d))
+    return float(ts[lo + k] + s[k] * (ts[lo + k + 1] - ts[lo + k])), float(d[k])
 
 
 def first_entry(
