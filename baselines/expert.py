@@ -51,7 +51,13 @@ class SGCExpert:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """Action(s) for one observation or a batch of them; the state is passed through."""
+        """Action(s) for one observation or a batch of them; the state is passed through.
+
+        A goal-conditioned (Dict) observation is read through its ``observation`` entry, which
+        holds the flat observation.
+        """
+        if isinstance(observation, dict):
+            observation = observation["observation"]
         obs = np.asarray(observation)
         if obs.ndim == 1:
             return self.action(obs), state

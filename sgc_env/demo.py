@@ -114,8 +114,13 @@ def run_demo(
     """Run, score and render the demo; ``progress(done, total)`` is called every tick."""
     import gymnasium as gym
 
-    from baselines.evaluation import goal_rows, run_episode, summarize, write_goals_csv
-    from baselines.evaluation import write_summary_json
+    from baselines.evaluation import (
+        goal_rows,
+        run_episode,
+        summarize,
+        write_goals_csv,
+        write_summary_json,
+    )
     from baselines.expert import SGCExpert
 
     options.out.mkdir(parents=True, exist_ok=True)

@@ -35,6 +35,8 @@ EMBED_DURATION = 0.15
 TARGET_FACE_X = 7.9
 TARGET_CENTER = (8.0, 0.0, 3.2)
 TARGET_HALF_EXTENTS = (0.1, 3.0, 2.2)
+LAUNCH_SPEED = 2.5
+"""The rods are thrown: they start along their path's tangent at this speed (m/s)."""
 FORCE_LIMIT = 150.0
 TORQUE_LIMIT = 30.0
 YAML_PATH = Path(__file__).parent / "scenarios" / "three_rods.yaml"
@@ -165,6 +167,7 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
     start = _align(_align(start, np.array([1.0, 0.0, 0.0])), tangent(knots[0]))
     tip_start = points[0]
     com_start = tip_start - start.apply(TIP)
+    launch = tangent(knots[0]) / np.linalg.norm(tangent(knots[0])) * LAUNCH_SPEED
     goals: list[dict[str, Any]] = []
     previous = start
     pierce = spec.samples_before - 1
@@ -208,6 +211,7 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
         "color": list(spec.color),
         "position": _vec(com_start),
         "orientation": _quat(start),
+        "linear_velocity": _vec(launch),
         "force_limit": FORCE_LIMIT,
         "torque_limit": TORQUE_LIMIT,
         "end_velocity": [0.0, 0.0, 0.0],

@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
         TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
         task = bar.add_task("demo", total=None)
-        result = run_demo(options, lambda done, total: bar.update(task, completed=done, total=total))
+        result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
     elapsed = time.perf_counter() - started
 
     table = Table(title="three-rod demo: the expert, scored by the harness")
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         f"{bool(summary['terminated'])}, {elapsed:.1f} s wall clock"
     )
     console.print(f"outputs in {args.out}/:")
-    for name, path in sorted(result.files.items()):
+    for path in sorted(result.files.values()):
         console.print(f"  {path}")
     return 0 if summary["goals_met"] == summary["n_goals"] and not summary["terminated"] else 1
 

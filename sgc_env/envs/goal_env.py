@@ -4,7 +4,7 @@ Dict observation:
 
 | key | size | meaning |
 |---|---|---|
-| observation | 13 n | per body: position, orientation, linear and angular velocity (no goal data) |
+| observation | as SGCEnv | the full flat observation of :class:`SGCEnv` (bodies and goal data) |
 | achieved_goal | 4 | tracked point of body 0 and the current time |
 | desired_goal | 4 | nail of body 0's current position goal and that goal's time (the deadline) |
 
@@ -37,9 +37,10 @@ class SGCGoalEnv(SGCEnv):
             raise ValueError("the goal-conditioned env needs a position track on body 0")
         self.tolerance = float(tolerance)
         box = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (4,), np.float32)
+        flat = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
         self.observation_space = gym.spaces.Dict(
             {
-                "observation": gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (13 * self._n,), np.float32),
+                "observation": flat,
                 "achieved_goal": box,
                 "desired_goal": box,
             }
@@ -50,7 +51,7 @@ class SGCGoalEnv(SGCEnv):
         k = self._pos_idx[0]
         t = self._tick * self.dt
         return {
-            "observation": self._block[:, 0:13].ravel().astype(np.float32),
+            "observation": self._obs.copy(),
             "achieved_goal": np.array([*self._point_pos[0], t], dtype=np.float32),
             "desired_goal": np.array([*tr.targets[k], tr.times[k]], dtype=np.float32),  # type: ignore[union-attr]
         }

@@ -76,6 +76,7 @@ plain reset).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -643,6 +644,33 @@ class SGCEnv(gym.Env):
         """Return to a :meth:`save_state` snapshot; returns the observation there."""
         self.sim.restore_state(state.bullet_state)
         self._apply_counters(state.counters)
+        self._observe()
+        return self._obs
+
+    def apply_impulse(
+        self,
+        body: int | str,
+        linear: Sequence[float],
+        angular: Sequence[float] = (0.0, 0.0, 0.0),
+    ) -> np.ndarray:
+        """Push a body between steps (a disturbance); returns the observation after the push.
+
+        ``linear`` (N s) and ``angular`` (N m s, world frame, about the centre of mass) change
+        the body's velocities at once, as an impact would. Policies see the push in the
+        returned observation, which replaces the one from the last step.
+        """
+        i = self.scenario.body_index(body) if isinstance(body, str) else int(body)
+        if not 0 <= i < self._n:
+            raise ValueError(f"body: no body {body!r} in a scene of {self._n}")
+        dp, dl = np.asarray(linear, dtype=float), np.asarray(angular, dtype=float)
+        if dp.shape != (3,) or dl.shape != (3,) or not np.all(np.isfinite([*dp, *dl])):
+            raise ValueError(f"impulse must be two finite 3-vectors, got {linear!r}, {angular!r}")
+        pos, orn, lin, ang = self._states[i]
+        rm = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        inverse_inertia = rm @ np.diag(1.0 / self.body_inertia[i]) @ rm.T
+        new_lin = np.asarray(lin) + dp / self._mass[i]
+        new_ang = np.asarray(ang) + inverse_inertia @ dl
+        self.sim.reset_body(self._uids[i], pos, orn, new_lin.tolist(), new_ang.tolist())
         self._observe()
         return self._obs
 

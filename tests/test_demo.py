@@ -1,0 +1,114 @@
+"""The paper's three-rod demo: scene, exactness, piercing, hitting, integrity, outputs."""
+
+from __future__ import annotations
+
+import json
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import sgc_env
+from baselines.evaluation import run_episode
+from baselines.expert import SGCExpert
+from baselines.sgc.frames import normalized_frame
+from sgc_env import three_rods
+from sgc_env.cli import main
+from sgc_env.demo import DemoOptions
+
+MIN_SPEED_FRACTION = 0.1
+"""A rod 'never stops': its tip speed stays above this fraction of its mean flight speed."""
+
+
+@pytest.fixture(scope="module")
+def episode():
+    env = gym.make("SGCThreeRods-v0")
+    record = run_episode(SGCExpert(env), env, seed=0, keep_infos=True)
+    scenario = env.unwrapped.scenario
+    env.close()
+    return record, scenario
+
+
+def _tips(record) -> tuple[np.ndarray, np.ndarray]:
+    infos = [record.initial_info, *record.infos]
+    times = np.array([info.get("time", 0.0) for info in infos])
+    return times, np.stack([np.asarray(info["point_position"]) for info in infos])
+
+
+def test_shipped_yaml_is_what_the_builder_makes():
+    shipped = yaml.safe_load(three_rods.YAML_PATH.read_text())
+    assert shipped == yaml.safe_load(yaml.safe_dump(three_rods.build_three_rods()))
+    assert [len(b["goals"]) for b in shipped["bodies"]] == [25, 16, 17]
+    somersaults = [g for b in shipped["bodies"] for g in b["goals"] if "relative_rotation" in g]
+    assert len(somersaults) == 1
+    assert np.linalg.norm(somersaults[0]["relative_rotation"]) > 2 * np.pi
+
+
+def test_every_rod_meets_every_goal_exactly(episode):
+    record, scenario = episode
+    assert not record.terminated
+    events = [e for info in record.infos for e in info.get("goal_reached", [])]
+    assert len(events) == sum(len(b.goals) for b in scenario.bodies) == 58
+    for event in events:
+        assert event["position_error"] <= 1e-9
+        assert event["orientation_error"] is None or event["orientation_error"] <= 1e-9
+    for info in record.infos:
+        for force, body in zip(info["force"], scenario.bodies, strict=True):
+            assert np.linalg.norm(force, np.inf) <= body.force_limit
+
+
+def test_tips_pierce_their_balls_and_hit_the_target(episode):
+    record, scenario = episode
+    times, tips = _tips(record)
+    props = {p.name: p for p in scenario.props}
+    target = props["target"]
+    face_x = target.position[0] - target.size[0]
+    for b, body in enumerate(scenario.bodies):
+        ball = props[f"ball_{body.name[4:]}"]
+        tick = int(np.argmin(np.abs(times - three_rods.PIERCE_TIME)))
+        assert np.linalg.norm(tips[tick, b] - ball.position_at(times[tick])) < 1e-9
+        hit = [g for g in body.goals if g.time is not None][-2]
+        tick = int(np.argmin(np.abs(times - hit.time)))
+        assert abs(tips[tick, b, 0] - face_x) < 1e-9
+        assert abs(tips[tick, b, 1] - target.position[1]) < target.size[1]
+        assert abs(tips[tick, b, 2] - target.position[2]) < target.size[2]
+
+
+def test_rods_never_stop_and_never_oscillate_along_a_course(episode):
+    record, scenario = episode
+    times, tips = _tips(record)
+    speeds = np.linalg.norm(np.diff(tips, axis=0), axis=2) / np.diff(times)[:, None]
+    for b, body in enumerate(scenario.bodies):
+        nails = [np.asarray(g.nail) for g in body.goals]
+        goal_times = [g.time for g in body.goals]
+        flight = times[1:] <= goal_times[-2]
+        assert speeds[flight, b].min() >= MIN_SPEED_FRACTION * speeds[flight, b].mean()
+        previous, start = tips[0, b], 0.0
+        for j, (nail, end) in enumerate(zip(nails[:-1], goal_times[:-1], strict=True)):
+            frame = normalized_frame(previous - nail, nail - nails[j + 1])
+            inside = (times >= start) & (times < end - 1e-9)
+            components = (tips[inside, b] - nail) @ frame.T
+            # every component of the deviation in S_i keeps its sign: no overshoot, no swing
+            assert np.all(components > 0.0), (body.name, j)
+            previous, start = nail, end
+
+
+def test_demo_command_writes_every_output(tmp_path, capsys):
+    out = tmp_path / "demo"
+    code = main(["demo", "--out", str(out), "--width", "96", "--height", "64"])
+    assert code == 0
+    expected = {
+        "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png",
+        "goals.csv", "summary.json", "rods.json",
+    }  # fmt: skip
+    assert expected <= {p.name for p in out.iterdir()}
+    rods = json.loads((out / "rods.json").read_text())
+    assert [r["goals"] for r in rods] == [25, 16, 17]
+    assert all(r["position_error_max_m"] <= 1e-9 for r in rods)
+    assert "58/58 goals met" in capsys.readouterr().out
+
+
+def test_demo_options_are_validated():
+    with pytest.raises(ValueError, match="width"):
+        DemoOptions(out=sgc_env.__path__[0], width=0)
