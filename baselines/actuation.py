@@ -14,13 +14,17 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from baselines.env_model import BodyModel, EnvModel
+from baselines.sgc import quaternion as quat
 from baselines.tracking import (
     held_acceleration_for_position,
     simulate_rotation,
     torque_for_orientation,
 )
 
-__all__ = ["BodyObservation", "read_body", "wrench_for_targets"]
+__all__ = ["BodyObservation", "body_wrench", "read_body", "wrench_for_targets"]
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
 
 _TRACKS = ("position", "orientation")
 _TRACK_FIELDS = (
@@ -94,30 +98,60 @@ def wrench_for_targets(
     ``point_displacement``: how far the tracked point must move (``D_next - D``); None lets
     the centre of mass coast (gravity compensated). ``rotation_change``: world rotation from
     now to the next tick; None applies no torque (free rotation). ``exact_rotation`` asks for
-    the Newton-refined torque (goal ticks) instead of the closed-form first guess.
+    the Newton-refined torque (goal ticks) instead of the once-corrected first guess.
+    """
+    force, torque = body_wrench(
+        model, body, tuple(state.orientation.tolist()), tuple(state.angular_velocity.tolist()),
+        tuple(state.linear_velocity.tolist()), tuple(state.point_offset.tolist()),
+        None if point_displacement is None else tuple(np.asarray(point_displacement, float)),
+        None if rotation_change is None else tuple(rotation_change.as_quat().tolist()),
+        exact_rotation=exact_rotation,
+    )  # fmt: skip
+    return np.array(force), np.array(torque)
+
+
+def body_wrench(
+    model: EnvModel,
+    body: BodyModel,
+    orientation: Quat,
+    angular_velocity: Vec3,
+    linear_velocity: Vec3,
+    point_offset: Vec3,
+    point_displacement: Vec3 | None,
+    rotation_change: Quat | None,
+    *,
+    exact_rotation: bool,
+    refine: bool = True,
+) -> tuple[Vec3, Vec3]:
+    """:func:`wrench_for_targets` on plain-float tuples (quaternions ``(x, y, z, w)``).
+
+    The expert calls this every control step, where numpy and scipy calls on 3-vectors would
+    cost more than the arithmetic. ``refine=False`` skips the correction step of the torque
+    between goals (see :func:`baselines.tracking.torque_for_orientation`).
     """
     h, n = model.sim_dt, model.substeps
-    q = state.orientation
-    rotation = Rotation.from_quat(q)
+    q = orientation
     if rotation_change is None:
-        torque = np.zeros(3)
-        next_rotation = Rotation.from_quat(
-            simulate_rotation(q, state.angular_velocity, (0.0, 0.0, 0.0), body.inertia, h, n)[0]
-        )
+        torque = (0.0, 0.0, 0.0)
+        next_q = None
     else:
-        next_rotation = rotation_change * rotation
-        torque = np.array(
-            torque_for_orientation(
-                q, state.angular_velocity, next_rotation.as_quat(), body.inertia, h, n,
-                exact=exact_rotation,
-            )
+        next_q = quat.mul(rotation_change, q)
+        torque = torque_for_orientation(
+            q, angular_velocity, next_q, body.inertia, h, n, exact=exact_rotation, refine=refine
         )
+    gx, gy, gz = model.gravity
+    mass = body.mass
     if point_displacement is None:
-        accel = np.zeros(3)
-    else:
-        offset = state.point_offset
-        offset_move = next_rotation.apply(offset) - rotation.apply(offset)
-        com_move = np.asarray(point_displacement, dtype=float) - offset_move
-        accel = held_acceleration_for_position(np.zeros(3), state.linear_velocity, com_move, h, n)
-    force = body.mass * (accel - np.asarray(model.gravity))
-    return force, torque
+        return (-mass * gx, -mass * gy, -mass * gz), torque
+    if next_q is None:
+        next_q = simulate_rotation(q, angular_velocity, torque, body.inertia, h, n)[0]
+    ax, ay, az = quat.rotate(next_q, point_offset)
+    bx, by, bz = quat.rotate(q, point_offset)
+    dx, dy, dz = point_displacement
+    vx, vy, vz = linear_velocity
+    accel = held_acceleration_for_position  # per component: plain floats, no arrays
+    return (
+        mass * (accel(0.0, vx, dx - (ax - bx), h, n) - gx),
+        mass * (accel(0.0, vy, dy - (ay - by), h, n) - gy),
+        mass * (accel(0.0, vz, dz - (az - bz), h, n) - gz),
+    ), torque

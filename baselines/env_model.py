@@ -65,23 +65,29 @@ class EnvModel:
             use_torque=bool(base.use_torque),
         )
 
-    def action_from_wrenches(self, forces: np.ndarray, torques: np.ndarray) -> np.ndarray:
-        """Normalised, clipped action from world forces (N) and torques (N m).
+    def action_from_wrenches(self, forces, torques) -> np.ndarray:
+        """Normalised, clipped action from world forces (N) and torques (N m), one per body.
 
-        The action is float64 on purpose: rounding it to the float32 of the action space moves
-        a thin rod's orientation at a goal by up to ~1e-9 rad (its axial inertia amplifies the
-        rounding of the world torque), and the env uses whatever precision it is given.
+        ``forces`` and ``torques``: arrays of shape (n, 3) or sequences of 3-tuples (the
+        expert passes tuples; plain floats keep its control step cheap). The action is float64
+        on purpose: rounding it to the float32 of the action space moves a thin rod's
+        orientation at a goal by up to ~1e-9 rad (its axial inertia amplifies the rounding of
+        the world torque), and the env uses whatever precision it is given.
         """
         n = len(self.bodies)
-        f_lim = np.array([b.force_limit for b in self.bodies])[:, None]
-        scaled_f = np.asarray(forces, dtype=float).reshape(n, 3) / f_lim
-        if self.use_torque:
-            t_lim = np.array([b.torque_limit for b in self.bodies])[:, None]
-            scaled_t = np.asarray(torques, dtype=float).reshape(n, 3) / t_lim
-            scaled = np.concatenate([scaled_f, scaled_t], axis=1)
-        else:
-            scaled = scaled_f
-        return np.clip(scaled.reshape(-1), -1.0, 1.0)
+        if isinstance(forces, np.ndarray):
+            forces = forces.reshape(n, 3).tolist()
+        if isinstance(torques, np.ndarray):
+            torques = torques.reshape(n, 3).tolist()
+        out: list[float] = []
+        use_torque = self.use_torque
+        for body, (fx, fy, fz), (tx, ty, tz) in zip(self.bodies, forces, torques, strict=True):
+            f_lim = body.force_limit
+            out += (fx / f_lim, fy / f_lim, fz / f_lim)
+            if use_torque:
+                t_lim = body.torque_limit
+                out += (tx / t_lim, ty / t_lim, tz / t_lim)
+        return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
 
 
 def _unwrap(env: Any) -> Any:

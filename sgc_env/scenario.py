@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from baselines.sgc import quaternion as quat
 from baselines.sgc.routing import resolve_goal_times
 
 __all__ = [
@@ -630,39 +631,9 @@ def _validate_goal(
 # ---------------------------------------------------------------- resolution
 
 
-def _rotate(q: Sequence[float], v: Sequence[float]) -> np.ndarray:
-    x, y, z, w = q
-    u = np.array([x, y, z])
-    v = np.asarray(v, float)
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
-
-
 def _rotation_angle(qa: Sequence[float], qb: Sequence[float]) -> float:
     dot = abs(float(np.dot(qa, qb)))
     return 2.0 * math.acos(min(1.0, dot))
-
-
-def _quat_from_rotvec(r: Sequence[float]) -> np.ndarray:
-    r = np.asarray(r, float)
-    angle = float(np.linalg.norm(r))
-    if angle < 1e-12:
-        return np.array([0.5 * r[0], 0.5 * r[1], 0.5 * r[2], 1.0]) / math.sqrt(1 + 0.25 * angle**2)
-    axis = r / angle
-    return np.concatenate((axis * math.sin(angle / 2), [math.cos(angle / 2)]))
-
-
-def _quat_mul(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return np.array(
-        [
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz,
-        ]
-    )
 
 
 def _on_grid(t: float, freq: int, mode: str, path: str) -> float:
@@ -710,13 +681,13 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
         if g.has_position:
             nail = _goal_nail(g, s, times[-1])
             if prev_point is None:
-                prev_point = np.asarray(b.position, float) + _rotate(b.orientation, g.point)
+                prev_point = np.asarray(b.position, float) + quat.rotate(b.orientation, g.point)
             dist = float(np.linalg.norm(nail - prev_point)) if nail is not None else 0.0
             prev_point = nail
         if g.has_orientation:
             if g.relative_rotation is not None:
                 angle = float(np.linalg.norm(g.relative_rotation))
-                q = _quat_mul(_quat_from_rotvec(g.relative_rotation), prev_q)
+                q = quat.mul(quat.exp_normalized(g.relative_rotation), prev_q)
             else:
                 q = np.asarray(g.orientation, float)
                 angle = _rotation_angle(prev_q, q)

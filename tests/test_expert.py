@@ -96,3 +96,28 @@ def test_expert_rejects_a_wrong_observation():
     env = gym.make("SGCPoint-v0")
     with pytest.raises(ValueError, match="observation has shape"):
         SGCExpert(env).predict(np.zeros(5))
+    obs, _ = env.reset(seed=0)
+    obs[3] = np.nan
+    with pytest.raises(ValueError, match="non-finite"):
+        SGCExpert(env).predict(obs)
+
+
+def test_without_the_torque_correction_goals_stay_exact():
+    env = gym.make("SGCThreeRods-v0")
+    record = run_episode(SGCExpert(env, refine=False), env, seed=7, keep_infos=True)
+    env.close()
+    _assert_exact(record, "SGCThreeRods-v0")
+
+
+def test_actions_from_tuples_equal_actions_from_arrays():
+    env = gym.make("SGCThreeRods-v0")
+    model = SGCExpert(env).model
+    env.close()
+    rng = np.random.default_rng(0)
+    forces, torques = rng.normal(size=(3, 3)) * 50.0, rng.normal(size=(3, 3))
+    from_arrays = model.action_from_wrenches(forces, torques)
+    from_tuples = model.action_from_wrenches(
+        [tuple(f) for f in forces.tolist()], [tuple(t) for t in torques.tolist()]
+    )
+    assert from_arrays.dtype == np.float64 and np.array_equal(from_arrays, from_tuples)
+    assert np.max(np.abs(from_arrays)) <= 1.0

@@ -17,6 +17,7 @@ from baselines.sgc.frames import (
     choose_k,
     condition_14,
     course_end_velocity,
+    next_deviation,
     normalized_frame,
     solve_course_in_frame,
 )
@@ -193,3 +194,28 @@ def test_resolve_in_frame_reproduces_the_course():
         np.testing.assert_allclose(part.evaluate(s)[0], full.evaluate(t + s)[0], atol=1e-9)
         for a, b in zip(part.profiles, full.profiles, strict=True):
             assert a.alpha == pytest.approx(b.alpha, rel=1e-7, abs=1e-7)
+
+
+@pytest.mark.parametrize("case", range(40))
+def test_next_deviation_is_the_re_solved_course(case):
+    """The expert's plain-float path and solve_course_in_frame share the component rules."""
+    rng = np.random.default_rng(case)
+    d_start, d_next = rng.normal(size=3), rng.normal(size=3)
+    kind = case % 4
+    if kind == 1:
+        d_next = None  # last goal: arrive at the given end velocity
+    v_end, info = course_end_velocity(
+        d_start, d_next, 1.0, 0.8, end_velocity=rng.normal(size=3) if kind == 1 else None
+    )
+    deviation, rate = d_start * rng.uniform(0.1, 1.0), rng.normal(size=3)
+    if kind == 2:
+        v_end = np.zeros(3)  # arrive at rest: Hermite components
+    if kind == 3:
+        deviation, rate, v_end, info = np.zeros(3), np.zeros(3), np.zeros(3), None  # dwell
+    frame = None if info is None else info.frame
+    course = solve_course_in_frame(frame, deviation, rate, 0.5, v_end)
+    rows = tuple(map(tuple, np.eye(3) if frame is None else frame))
+    fast = next_deviation(
+        rows, tuple(deviation), tuple(rate), 0.5, tuple(v_end.tolist()), 1.0 / 60.0
+    )
+    assert np.array_equal(np.array(fast), course.state(1.0 / 60.0)[0])

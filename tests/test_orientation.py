@@ -15,6 +15,7 @@ from baselines.sgc.orientation import (
     angular_velocity,
     left_jacobian,
     left_jacobian_inverse,
+    left_jacobian_inverse_apply,
     orientation_deviation,
     quat_to_rotvec,
     rotvec_to_quat,
@@ -100,3 +101,19 @@ def test_unwrap_identity_and_same_rotation():
     phi = unwrap_rotvec(np.array([0.0, 0.0, 0.5]), np.array([0.0, 0.0, -5.0]))
     np.testing.assert_allclose(phi, [0, 0, 0.5 - 2 * math.pi])
     assert Rotation.from_rotvec(phi).approx_equal(Rotation.from_rotvec([0, 0, 0.5]))
+
+
+@pytest.mark.parametrize("scale", [0.0, 1e-6, 0.04, 0.06, 2.0, 9.0])
+def test_left_jacobian_inverse_apply_matches_the_matrix(scale):
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        phi, omega = rng.normal(size=3) * scale, rng.normal(size=3)
+        fast = left_jacobian_inverse_apply(tuple(phi), tuple(omega))
+        assert np.allclose(fast, left_jacobian_inverse(phi) @ omega, rtol=1e-12, atol=1e-14)
+        assert np.allclose(left_jacobian(phi) @ np.array(fast), omega, atol=1e-12)
+
+
+def test_left_jacobian_inverse_apply_is_least_squares_where_singular():
+    phi = np.array([2.0 * math.pi, 0.0, 0.0])
+    omega = np.array([0.3, 0.0, 0.0])  # along the axis: representable
+    assert np.allclose(left_jacobian_inverse_apply(phi, omega), omega, atol=1e-12)

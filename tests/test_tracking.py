@@ -8,6 +8,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from baselines.tracking import (
+    _linear_model,
+    _linear_model_axisymmetric,
+    _simulate_axisymmetric,
     held_acceleration_for_position,
     rotation_residual,
     simulate_rotation,
@@ -87,3 +90,32 @@ def test_first_guess_is_close_for_gentle_targets(rod):
     torque = torque_for_orientation(q0, w0, q_target, inertia, H, SUBSTEPS, exact=False)
     reached, _ = simulate_rotation(q0, w0, torque, inertia, H, SUBSTEPS)
     assert np.max(np.abs(rotation_residual(reached, q_target))) < 1e-6
+
+
+@pytest.mark.parametrize("inertia", [(0.02, 0.02, 1e-5), (0.3, 0.3, 0.3), (1.0, 1.0, 0.5)])
+def test_axisymmetric_closed_forms_match_the_matrix_forms(inertia):
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q = tuple(Rotation.random(random_state=rng).as_quat())
+        w, tau = tuple(rng.normal(size=3) * 5), tuple(rng.normal(size=3) * 0.01)
+        a_general, g_general = _linear_model(q, w, inertia, H, SUBSTEPS)
+        a_fast, g_fast = _linear_model_axisymmetric(q, w, inertia, H, SUBSTEPS)
+        assert np.allclose(a_fast, a_general, rtol=1e-13, atol=1e-15 * np.max(a_general))
+        assert np.allclose(g_fast, g_general, rtol=1e-11, atol=1e-15)
+        q_matrix, w_matrix = simulate_rotation(q, w, tau, inertia, H, SUBSTEPS)
+        q_fast, w_fast = _simulate_axisymmetric(q, w, tau, inertia, H, SUBSTEPS)
+        assert np.max(np.abs(rotation_residual(q_fast, q_matrix))) < 1e-14
+        assert np.allclose(w_fast, w_matrix, rtol=1e-12, atol=1e-12)
+
+
+def test_refine_false_returns_the_first_guess(rod):
+    _, _, _, inertia = rod
+    q0 = Rotation.from_rotvec([0.1, 0.2, 0.3]).as_quat()
+    w0 = np.array([0.2, -0.1, 0.05])
+    q_target = (Rotation.from_rotvec(w0 * SUBSTEPS * H + 1e-4) * Rotation.from_quat(q0)).as_quat()
+    args = (q0, w0, q_target, inertia, H, SUBSTEPS)
+    guess = torque_for_orientation(*args, exact=False, refine=False)
+    corrected = torque_for_orientation(*args, exact=False)
+    reached = [simulate_rotation(q0, w0, t, inertia, H, SUBSTEPS)[0] for t in (guess, corrected)]
+    miss = [np.max(np.abs(rotation_residual(r, q_target))) for r in reached]
+    assert miss[1] < miss[0] < 1e-6

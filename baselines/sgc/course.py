@@ -570,14 +570,16 @@ class HermiteProfile:
     branch: str = "hermite"
 
     def state(self, t: float) -> tuple[float, float, float]:
-        """``(D, D', D'')`` at scalar ``t``."""
-        d, v, a = self.evaluate(t)
-        return float(d), float(v), float(a)
+        """``(D, D', D'')`` at scalar ``t`` (plain floats: the expert's per-step path)."""
+        return self._cubic(float(t) / self.duration)
 
     def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(D, D', D'')`` at ``t`` seconds from the course start."""
+        return self._cubic(np.asarray(t, dtype=float) / self.duration)
+
+    def _cubic(self, s):
+        """The cubic and its derivatives at normalised time ``s`` (a float or an array)."""
         T = self.duration
-        s = np.asarray(t, dtype=float) / T
         d0, m0, m1 = self.d0, self.v0 * T, self.end_velocity * T
         # Hermite basis, end value 0: h00 = 2s^3-3s^2+1, h10 = s^3-2s^2+s, h11 = s^3-s^2
         d = d0 * (2 * s**3 - 3 * s**2 + 1) + m0 * (s**3 - 2 * s**2 + s) + m1 * (s**3 - s**2)

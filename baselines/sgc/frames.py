@@ -44,6 +44,7 @@ __all__ = [
     "choose_k",
     "condition_14",
     "course_end_velocity",
+    "next_deviation",
     "normalized_frame",
     "solve_course_in_frame",
     "turn_angle",
@@ -113,10 +114,15 @@ def _frame_rows(d, nxt):
     ), norm
 
 
-def _mul(rows, v):
+def _mul(rows, v) -> tuple[float, float, float]:
     """``R @ v`` for rows and a vector given as tuples."""
     v0, v1, v2 = v
-    return tuple(r[0] * v0 + r[1] * v1 + r[2] * v2 for r in rows)
+    r0, r1, r2 = rows
+    return (
+        r0[0] * v0 + r0[1] * v1 + r0[2] * v2,
+        r1[0] * v0 + r1[1] * v1 + r1[2] * v2,
+        r2[0] * v0 + r2[1] * v1 + r2[2] * v2,
+    )
 
 
 def _mul_t(rows, s):
@@ -363,21 +369,51 @@ def solve_course_in_frame(
         rows = _IDENTITY_ROWS
     else:
         rows = tuple(tuple(r) for r in (frame.tolist() if isinstance(frame, np.ndarray) else frame))
-    d = _mul(rows, _vec3(deviation_now, "deviation_now"))
-    v = _mul(rows, _vec3(velocity_now, "velocity_now"))
-    ve = _mul(rows, _vec3(end_velocity, "end_velocity"))
+    profiles = _component_profiles(
+        _mul(rows, _vec3(deviation_now, "deviation_now")),
+        _mul(rows, _vec3(velocity_now, "velocity_now")),
+        _mul(rows, _vec3(end_velocity, "end_velocity")),
+        time_left,
+    )
+    return FrameCourse(rows, profiles, time_left)
+
+
+def next_deviation(
+    rows, deviation_now, velocity_now, time_left: float, end_velocity, t: float
+) -> tuple[float, float, float]:
+    """World ``D(t)`` of the course :func:`solve_course_in_frame` would return, in plain floats.
+
+    ``rows``: ``S_i`` as three row tuples (the identity for a dwell), the 3-vectors as tuples
+    of floats; no validation beyond :meth:`CourseProfile.solve`'s. The expert calls this every
+    control step; it shares the per-component rules with :func:`solve_course_in_frame`.
+    """
+    if not time_left > 0.0:
+        raise ValueError(f"time_left must be > 0, got {time_left!r}")
+    p0, p1, p2 = _component_profiles(
+        _mul(rows, deviation_now), _mul(rows, velocity_now), _mul(rows, end_velocity), time_left
+    )
+    return _mul_t(rows, (p0.state(t)[0], p1.state(t)[0], p2.state(t)[0]))
+
+
+def _component_profiles(d, v, ve, time_left: float) -> tuple:
+    """The three component profiles of a course in ``S_i`` (components given in ``S_i``)."""
     rest = ve == _ZERO3
     if rest and d == _ZERO3 and v == _ZERO3:
         hold = HoldProfile(time_left)
-        return FrameCourse(rows, (hold, hold, hold), time_left)
-    profiles = []
-    for dj, vj, vej in zip(d, v, ve, strict=True):
-        k = -vej * time_left / dj if dj != 0.0 else 0.0
-        if rest or k <= 0.0:
-            profiles.append(HermiteProfile(dj, vj, time_left, vej))
-            continue
-        try:
-            profiles.append(CourseProfile.solve(dj, vj, time_left, k))
-        except ValueError:  # gamma T - log k out of the representable range
-            profiles.append(HermiteProfile(dj, vj, time_left, vej))
-    return FrameCourse(rows, profiles, time_left)
+        return hold, hold, hold
+    return (
+        _component_profile(d[0], v[0], ve[0], time_left, rest),
+        _component_profile(d[1], v[1], ve[1], time_left, rest),
+        _component_profile(d[2], v[2], ve[2], time_left, rest),
+    )
+
+
+def _component_profile(dj: float, vj: float, vej: float, time_left: float, rest: bool):
+    """SGC where it applies, else the Hermite cubic (rules in :func:`solve_course_in_frame`)."""
+    k = -vej * time_left / dj if dj != 0.0 else 0.0
+    if rest or k <= 0.0:
+        return HermiteProfile(dj, vj, time_left, vej)
+    try:
+        return CourseProfile.solve(dj, vj, time_left, k)
+    except ValueError:  # gamma T - log k out of the representable range
+        return HermiteProfile(dj, vj, time_left, vej)

@@ -24,6 +24,7 @@ __all__ = [
     "angular_velocity",
     "left_jacobian",
     "left_jacobian_inverse",
+    "left_jacobian_inverse_apply",
     "orientation_deviation",
     "quat_to_rotvec",
     "rotvec_to_quat",
@@ -74,19 +75,41 @@ def left_jacobian_inverse(phi) -> np.ndarray:
     Raises ValueError within 1e-9 rad of ``theta = 2 pi n`` where ``J_l`` is singular.
     """
     phi = np.asarray(phi, dtype=float)
-    theta = float(np.linalg.norm(phi))
+    e = _inverse_coefficient(float(np.linalg.norm(phi)))
     k = _skew(phi)
+    return np.eye(3) - 0.5 * k + e * (k @ k)
+
+
+def _inverse_coefficient(theta: float) -> float:
+    """``1/theta^2 - (1 + cos)/(2 theta sin)`` of ``J_l^-1``; ValueError where singular."""
     if theta < 0.05:
         t2 = theta * theta
-        e = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
-    else:
-        n = round(theta / _TWO_PI)
-        if n >= 1 and abs(theta - n * _TWO_PI) < 1e-9:
-            raise ValueError(
-                f"phi has length {theta!r} = 2*pi*{n}: the left Jacobian is singular there"
-            )
-        e = 1.0 / (theta * theta) - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
-    return np.eye(3) - 0.5 * k + e * (k @ k)
+        return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0
+    n = round(theta / _TWO_PI)
+    if n >= 1 and abs(theta - n * _TWO_PI) < 1e-9:
+        raise ValueError(
+            f"phi has length {theta!r} = 2*pi*{n}: the left Jacobian is singular there"
+        )
+    return 1.0 / (theta * theta) - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
+
+
+def left_jacobian_inverse_apply(phi, omega) -> tuple[float, float, float]:
+    """``phi_dot`` with ``J_l(phi) phi_dot = omega``, in plain floats (the expert's per-step
+    path: ``omega - phi x omega / 2 + e phi x (phi x omega)``, no 3x3 matrix).
+
+    Least squares where ``J_l`` is singular (``|phi| = 2 pi n``: the component of ``omega``
+    across the axis cannot be represented).
+    """
+    px, py, pz = phi
+    wx, wy, wz = omega
+    try:
+        e = _inverse_coefficient(math.sqrt(px * px + py * py + pz * pz))
+    except ValueError:
+        solution = np.linalg.lstsq(left_jacobian(phi), np.asarray(omega, float), rcond=None)
+        return tuple(solution[0].tolist())
+    cx, cy, cz = py * wz - pz * wy, pz * wx - px * wz, px * wy - py * wx
+    ccx, ccy, ccz = py * cz - pz * cy, pz * cx - px * cz, px * cy - py * cx
+    return (wx - 0.5 * cx + e * ccx, wy - 0.5 * cy + e * ccy, wz - 0.5 * cz + e * ccz)
 
 
 def angular_velocity(phi, phi_dot) -> np.ndarray:

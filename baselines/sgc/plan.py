@@ -37,7 +37,7 @@ from baselines.sgc.frames import solve_course_in_frame as _solve_in_frame
 from baselines.sgc.orientation import (
     angular_acceleration,
     left_jacobian,
-    left_jacobian_inverse,
+    left_jacobian_inverse_apply,
 )
 
 __all__ = [
@@ -241,15 +241,6 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
     return out
 
 
-def _jl_inverse_apply(phi: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """``phi_dot`` with ``J_l(phi) phi_dot = omega``; least squares where ``J_l`` is singular
-    (``|phi| = 2 pi n``: the component of ``omega`` across the axis cannot be represented)."""
-    try:
-        return left_jacobian_inverse(phi) @ omega
-    except ValueError:
-        return np.linalg.lstsq(left_jacobian(phi), omega, rcond=None)[0]
-
-
 def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
     rots: list[Rotation] = []
     starts: list[np.ndarray] = []
@@ -268,7 +259,7 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
         rots.append(goal)
         starts.append(phi0)
         prev = goal
-    courses, t_prev, phi_dot = [], 0.0, _jl_inverse_apply(starts[0], w0)
+    courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
     for i, phi0 in enumerate(starts):
         T = times[i] - t_prev
         last = i == len(starts) - 1
@@ -282,7 +273,8 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
         courses.append(course)
         diags.append(_diag("orientation", i, t_prev, times[i], course, info))
         if not last:
-            phi_dot = _jl_inverse_apply(starts[i + 1], v_end)  # omega at phi = 0 is v_end
+            # omega at phi = 0 is v_end
+            phi_dot = np.array(left_jacobian_inverse_apply(starts[i + 1], v_end))
         t_prev = times[i]
     track = _Track([0.0, *times[:-1]], list(times), courses, courses[-1].state(
         courses[-1].duration)[1])

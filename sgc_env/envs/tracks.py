@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from baselines.sgc import quaternion
 from sgc_env.scenario import Body, Scenario
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "Track",
     "compile_tracks",
     "quat_conj_mul",
+    "quat_from_rotvec",
     "quat_mul",
     "rotate",
     "rotvec_from_quat",
@@ -27,58 +29,15 @@ __all__ = [
 ]
 
 
-def quat_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
-    """Hamilton product a*b in (x, y, z, w) order: the rotation R_a R_b."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    )
+quat_mul = quaternion.mul
+rotate = quaternion.rotate
+rotvec_from_quat = quaternion.log
+quat_from_rotvec = quaternion.exp_normalized
 
 
 def quat_conj_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
     """a * conj(b): the rotation R_a R_b^T."""
-    return quat_mul(a, (-b[0], -b[1], -b[2], b[3]))
-
-
-def rotate(q: Sequence[float], v: Sequence[float]) -> tuple[float, float, float]:
-    """R(q) v without building a matrix (pure Python: cheaper than numpy for one vector)."""
-    x, y, z, w = q
-    vx, vy, vz = v
-    tx = 2.0 * (y * vz - z * vy)
-    ty = 2.0 * (z * vx - x * vz)
-    tz = 2.0 * (x * vy - y * vx)
-    return (
-        vx + w * tx + (y * tz - z * ty),
-        vy + w * ty + (z * tx - x * tz),
-        vz + w * tz + (x * ty - y * tx),
-    )
-
-
-def rotvec_from_quat(q: Sequence[float]) -> tuple[float, float, float]:
-    """Principal rotation vector (angle in [0, pi]) of a unit quaternion."""
-    x, y, z, w = q
-    if w < 0.0:
-        x, y, z, w = -x, -y, -z, -w
-    s = math.sqrt(x * x + y * y + z * z)
-    if s < 1e-12:
-        return (2.0 * x, 2.0 * y, 2.0 * z)
-    k = 2.0 * math.atan2(s, w) / s
-    return (k * x, k * y, k * z)
-
-
-def quat_from_rotvec(r: Sequence[float]) -> tuple[float, float, float, float]:
-    angle = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
-    if angle < 1e-12:
-        q = (0.5 * r[0], 0.5 * r[1], 0.5 * r[2], 1.0)
-    else:
-        s = math.sin(0.5 * angle) / angle
-        q = (s * r[0], s * r[1], s * r[2], math.cos(0.5 * angle))
-    n = math.sqrt(sum(c * c for c in q))
-    return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+    return quaternion.mul(a, quaternion.conjugate(b))
 
 
 def unwrap_rotvec(
