@@ -206,7 +206,7 @@ def _videos(frames: list[np.ndarray], times: list[float], options: DemoOptions) 
 
     fps = 60 / options.frame_every
     mp4 = options.out / "three_rods.mp4"
-    imageio.mimwrite(mp4, frames, fps=fps, codec="libx264", quality=7, macro_block_size=8)
+    imageio.mimwrite(mp4, frames, fps=fps, codec="libx264", quality=7, macro_block_size=4)
     gif = options.out / "three_rods.gif"
     small = [f[:: options.gif_scale, :: options.gif_scale] for f in frames[::2]]
     imageio.mimwrite(gif, small, duration=1000 * 2 / fps, loop=0)

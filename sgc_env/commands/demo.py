@@ -45,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
     elapsed = time.perf_counter() - started
 
     table = Table(title="three-rod demo: the expert, scored by the harness")
-    for column in ("rod", "goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
+    table.add_column("rod", no_wrap=True)
+    for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
                    "SPARC", "min speed at goals / avg"):  # fmt: skip
         table.add_column(column, justify="right")
     for rod in result.per_rod:
