@@ -127,19 +127,24 @@ def algorithm_from_data(data: dict[str, Any]) -> str:
     raise ValueError(f"cannot tell the algorithm of a model with policy class from {module!r}")
 
 
-def load_sb3_model(path: str | Path) -> Any:
-    """Load a Stable-Baselines3 model zip on the CPU, detecting its algorithm."""
+def load_sb3_model(path: str | Path, env: Any | None = None, device: str = "cpu") -> Any:
+    """Load a Stable-Baselines3 model zip, detecting its algorithm.
+
+    ``env`` is passed through to SB3: a HER model (a ``HerReplayBuffer`` in its data) cannot be
+    loaded without the env that computes its rewards, and for the others SB3 checks that the
+    model's spaces match the env's.
+    """
     file = Path(path)
     if not file.is_file():
         raise ValueError(f"policy: model file {str(path)!r} does not exist")
     from stable_baselines3.common.save_util import load_from_zip_file
 
-    data, _, _ = load_from_zip_file(file, load_data=True, device="cpu")
+    data, _, _ = load_from_zip_file(file, load_data=True, device=device)
     if data is None:
         raise ValueError(f"policy: {str(path)!r} holds no model data")
     name = algorithm_from_data(data)
     algorithm = getattr(importlib.import_module("stable_baselines3"), name)
-    return algorithm.load(file, device="cpu")
+    return algorithm.load(file, env=env, device=device)
 
 
 def _needs_flat_observation(env: Any, spec: str) -> None:
@@ -164,7 +169,7 @@ def make_policy(spec: str, env: Any, seed: int | None = None) -> Any:
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
-        return load_sb3_model(spec)
+        return load_sb3_model(spec, env=env)
     raise ValueError(
         f"policy: unknown spec {spec!r}; expected one of {list(BUILTIN_POLICIES)} or the path "
         "of a Stable-Baselines3 model .zip"

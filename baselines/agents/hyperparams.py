@@ -1,0 +1,201 @@
+"""Hyperparameters in rl-zoo3's YAML format: one file per algorithm, keyed by env id.
+
+Kept in YAML (not code) so that a run is reproduced from the file plus the command line, and
+so that rl-zoo3 users can read them. String-valued entries such as
+``policy_kwargs: "dict(net_arch=[64, 64], activation_fn=nn.Tanh)"`` are parsed by a small
+whitelisting AST walker, never by ``eval``.
+"""
+
+from __future__ import annotations
+
+import ast
+import inspect
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+__all__ = [
+    "DEFAULT_HYPERPARAMS_DIR",
+    "Hyperparams",
+    "linear_schedule",
+    "load_hyperparams",
+    "parse_kwargs_string",
+]
+
+DEFAULT_HYPERPARAMS_DIR = Path(__file__).resolve().parents[2] / "hyperparams"
+"""``hyperparams/`` at the repository top (the package is installed editable)."""
+
+_ACTIVATIONS = ("ReLU", "Tanh", "ELU", "LeakyReLU", "SiLU", "GELU", "Sigmoid")
+_NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
+_STRING_KWARGS = ("policy_kwargs", "replay_buffer_kwargs")
+_ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std"}
+
+
+@dataclass
+class Hyperparams:
+    """One resolved entry: the zoo's own keys plus the keyword arguments for the SB3 class."""
+
+    env_id: str
+    algo: str
+    n_timesteps: int
+    policy: str
+    n_envs: int = 1
+    normalize: bool = False
+    noise_type: str | None = None
+    noise_std: float = 0.1
+    algo_kwargs: dict[str, Any] = field(default_factory=dict)
+    raw: dict[str, Any] = field(default_factory=dict)
+
+
+def _resolve_name(dotted: str, field_name: str) -> Any:
+    import torch.nn as nn
+
+    short = dotted
+    for prefix in _NAME_PREFIXES:
+        if dotted.startswith(prefix):
+            short = dotted[len(prefix) :]
+            break
+    if short in _ACTIVATIONS:
+        return getattr(nn, short)
+    if short == "StandardizeObservation":
+        from baselines.agents.features import StandardizeObservation
+
+        return StandardizeObservation
+    if short == "HerReplayBuffer":
+        from stable_baselines3 import HerReplayBuffer
+
+        return HerReplayBuffer
+    raise ValueError(f"{field_name}: name {dotted!r} is not allowed (activations: {_ACTIVATIONS})")
+
+
+def _dotted(node: ast.AST) -> str | None:
+    if isinstance(node, ast.Name):
+        return node.id
+    if isinstance(node, ast.Attribute):
+        base = _dotted(node.value)
+        return None if base is None else f"{base}.{node.attr}"
+    return None
+
+
+def _literal(node: ast.AST, field_name: str) -> Any:
+    if isinstance(node, ast.Constant):
+        return node.value
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+        value = _literal(node.operand, field_name)
+        if isinstance(value, (int, float)):
+            return -value
+    if isinstance(node, (ast.List, ast.Tuple)):
+        items = [_literal(e, field_name) for e in node.elts]
+        return items if isinstance(node, ast.List) else tuple(items)
+    if isinstance(node, ast.Dict):
+        return {
+            _literal(k, field_name): _literal(v, field_name)
+            for k, v in zip(node.keys, node.values, strict=True)
+            if k is not None
+        }
+    if isinstance(node, ast.Call) and _dotted(node.func) == "dict" and not node.args:
+        return {kw.arg: _literal(kw.value, field_name) for kw in node.keywords if kw.arg}
+    name = _dotted(node)
+    if name is not None:
+        return _resolve_name(name, field_name)
+    raise ValueError(f"{field_name}: unsupported expression {ast.unparse(node)!r}")
+
+
+def parse_kwargs_string(text: str, field_name: str = "policy_kwargs") -> dict[str, Any]:
+    """Parse ``"dict(net_arch=[64, 64], activation_fn=nn.Tanh)"`` without ``eval``."""
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except SyntaxError as exc:
+        raise ValueError(f"{field_name}: cannot parse {text!r}: {exc.msg}") from exc
+    value = _literal(tree.body, field_name)
+    if not isinstance(value, dict):
+        raise ValueError(f"{field_name}: expected dict(...) or {{...}}, got {text!r}")
+    return value
+
+
+def linear_schedule(initial: float):
+    """rl-zoo3's ``lin_<value>``: decays linearly from ``initial`` to 0 over training."""
+
+    def schedule(progress_remaining: float) -> float:
+        return progress_remaining * initial
+
+    return schedule
+
+
+def _learning_rate(value: Any) -> Any:
+    if isinstance(value, str):
+        if value.startswith("lin_"):
+            return linear_schedule(float(value[4:]))
+        try:
+            return float(value)
+        except ValueError as exc:
+            raise ValueError(
+                f"learning_rate: expected a number or lin_<number>, got {value!r}"
+            ) from exc
+    return float(value)
+
+
+def _algo_class(algo: str):
+    from baselines.agents.train import algorithm_class
+
+    return algorithm_class(algo)
+
+
+def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
+    """Read ``<directory>/<algo>.yml`` and resolve the entry for ``env_id``."""
+    algo_cls = _algo_class(algo)
+    path = Path(directory or DEFAULT_HYPERPARAMS_DIR) / f"{algo}.yml"
+    if not path.is_file():
+        raise ValueError(f"algo: no hyperparameter file {path}")
+    try:
+        table = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ValueError(f"{path}: bad YAML: {exc}") from exc
+    if not isinstance(table, dict):
+        raise ValueError(f"{path}: expected a mapping of env id -> hyperparameters")
+    if env_id not in table:
+        raise ValueError(f"env: {path} has no hyperparameters for {env_id!r} (has {sorted(table)})")
+    entry = table[env_id]
+    if not isinstance(entry, dict):
+        raise ValueError(f"{path}: entry {env_id!r} must be a mapping")
+    for key in ("n_timesteps", "policy"):
+        if key not in entry:
+            raise ValueError(f"{path}: {env_id}: missing field {key!r}")
+    kwargs: dict[str, Any] = {}
+    allowed = set(inspect.signature(algo_cls.__init__).parameters) - {"self", "policy", "env"}
+    for key, value in entry.items():
+        if key in _ZOO_KEYS:
+            continue
+        if key not in allowed:
+            raise ValueError(f"{path}: {env_id}: unknown field {key!r} for {algo_cls.__name__}")
+        if key in _STRING_KWARGS and isinstance(value, str):
+            value = parse_kwargs_string(value, key)
+        elif key == "learning_rate":
+            value = _learning_rate(value)
+        elif key == "replay_buffer_class" and isinstance(value, str):
+            value = _resolve_name(value, key)
+        kwargs[key] = value
+    noise_type = entry.get("noise_type")
+    if noise_type not in (None, "normal"):
+        raise ValueError(f"{path}: {env_id}: noise_type must be 'normal', got {noise_type!r}")
+    try:
+        n_timesteps = int(float(entry["n_timesteps"]))
+        n_envs = int(entry.get("n_envs", 1))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: {env_id}: n_timesteps and n_envs must be numbers") from exc
+    if n_envs < 1:
+        raise ValueError(f"{path}: {env_id}: n_envs must be >= 1, got {n_envs}")
+    return Hyperparams(
+        env_id=env_id,
+        algo=algo,
+        n_timesteps=n_timesteps,
+        policy=str(entry["policy"]),
+        n_envs=n_envs,
+        normalize=bool(entry.get("normalize", False)),
+        noise_type=noise_type,
+        noise_std=float(entry.get("noise_std", 0.1)),
+        algo_kwargs=kwargs,
+        raw=dict(entry),
+    )

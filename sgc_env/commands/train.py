@@ -1,0 +1,80 @@
+"""``sgc train``: train an SB3 agent on a registered id (see baselines.agents.train)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+
+ALGOS = ("ppo", "sac", "td3", "her")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--algo", required=True, choices=ALGOS, help="her = SAC + HerReplayBuffer")
+    parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v0")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
+    parser.add_argument(
+        "--out", default=None, help="run folder: tb/, checkpoints/, models, config.json"
+    )
+    parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
+    parser.add_argument(
+        "--eval-freq", type=int, default=0, help="env steps between harness evaluations (0: off)"
+    )
+    parser.add_argument("--eval-episodes", type=int, default=10)
+    parser.add_argument("--eval-seed", type=int, default=10_000, help="first held-out seed")
+    parser.add_argument(
+        "--checkpoint-freq", type=int, default=0, help="env steps between checkpoints (0: off)"
+    )
+    parser.add_argument(
+        "--init", choices=("none", "bc"), default="none", help="bc: clone --demos first"
+    )
+    parser.add_argument("--demos", default=None, help="npz from `sgc demos`")
+    parser.add_argument("--bc-epochs", type=int, default=30)
+    parser.add_argument(
+        "--bc-log-std", type=float, default=-2.0, help="PPO exploration after cloning"
+    )
+    parser.add_argument(
+        "--critic-warmup", type=int, default=0,
+        help="env steps of RL with the actor frozen, so the critic learns the clone first",
+    )  # fmt: skip
+    parser.add_argument("--dagger-rounds", type=int, default=0, help="DAgger rounds after cloning")
+    parser.add_argument("--dagger-episodes", type=int, default=20, help="rollouts per DAgger round")
+    parser.add_argument(
+        "--hyperparams", default=None, help="folder of <algo>.yml (default: hyperparams/)"
+    )
+    parser.add_argument("--env-kwargs", default=None, help="JSON dict passed to gym.make")
+    parser.add_argument("--device", default="cpu")
+    parser.add_argument("--verbose", type=int, default=0)
+
+
+def run(args: argparse.Namespace) -> int:
+    from baselines.agents.train import TrainConfig, train
+
+    env_kwargs = json.loads(args.env_kwargs) if args.env_kwargs else {}
+    if not isinstance(env_kwargs, dict):
+        raise ValueError(f"--env-kwargs must be a JSON object, got {args.env_kwargs!r}")
+    cfg = TrainConfig(
+        algo=args.algo, env_id=args.env, seed=args.seed, timesteps=args.timesteps,
+        out=args.out, progress=args.progress, eval_freq=args.eval_freq,
+        eval_episodes=args.eval_episodes, eval_seed=args.eval_seed, init=args.init,
+        demos=args.demos, bc_epochs=args.bc_epochs, bc_log_std=args.bc_log_std,
+        critic_warmup=args.critic_warmup,
+        dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
+        hyperparams_dir=args.hyperparams, env_kwargs=env_kwargs, device=args.device,
+        checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
+        command=shlex.join(["sgc", *sys.argv[1:]]),
+    )  # fmt: skip
+    result = train(cfg)
+    print(
+        f"{args.algo} on {args.env}: {result.timesteps} steps, learn {result.learn_time_s:.1f} s "
+        f"({result.steps_per_s:.0f} steps/s), total {result.wall_time_s:.1f} s"
+    )
+    if result.bc:
+        print(f"bc: loss {result.bc['loss_before']:.4g} -> {result.bc['loss_after']:.4g}")
+    if result.evaluations:
+        print(f"last evaluation: {json.dumps(result.evaluations[-1], sort_keys=True)}")
+    if result.model_path is not None:
+        print(f"model: {result.model_path}")
+    return 0
