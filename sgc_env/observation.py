@@ -79,14 +79,21 @@ BASE_BLOCK_SIZE = sum(size for _, size in BASE_FIELDS)
 _RESIDUAL_SOURCES = np.concatenate(
     [np.arange(*_BODY_OFFSETS[name]) for name in RESIDUAL_FIELDS]
 )
+_GATHER = np.concatenate([np.arange(BASE_BLOCK_SIZE), _RESIDUAL_SOURCES])
 
 
-def split_precision(base_blocks: np.ndarray) -> np.ndarray:
-    """float32 body blocks (base fields, then residuals) from float64 base blocks (n, base)."""
-    high = base_blocks.astype(np.float32)
-    sources = base_blocks[:, _RESIDUAL_SOURCES]
-    low = (sources - high[:, _RESIDUAL_SOURCES]).astype(np.float32)
-    return np.concatenate([high, low], axis=1)
+def split_precision(base_blocks: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """float32 body blocks (base fields, then residuals) from float64 base blocks (n, base).
+
+    ``out`` (float32, shape (n, BODY_BLOCK_SIZE)) is filled in place when given: the env
+    writes straight into its observation buffer (this runs every control step).
+    """
+    full = base_blocks[:, _GATHER]
+    if out is None:
+        out = np.empty(full.shape, dtype=np.float32)
+    out[...] = full
+    out[:, BASE_BLOCK_SIZE:] = full[:, BASE_BLOCK_SIZE:] - out[:, BASE_BLOCK_SIZE:]
+    return out
 
 
 @dataclass(frozen=True)

@@ -476,7 +476,10 @@ class SGCEnv(gym.Env):
         arr = np.array(flat)
         size = n * BASE_BLOCK_SIZE + 1
         self._block = arr[: size - 1].reshape(n, BASE_BLOCK_SIZE)
-        self._obs = np.append(split_precision(self._block).ravel(), np.float32(t))
+        obs = np.empty(self.layout.size, dtype=np.float32)
+        split_precision(self._block, obs[:-1].reshape(n, -1))
+        obs[-1] = t
+        self._obs = obs
         self._tail = arr[size:].reshape(3, n, 3)
         self._point_pos = points
         self._cost = cost
