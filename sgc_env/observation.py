@@ -7,6 +7,7 @@ so that nobody hard-codes offsets.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -76,24 +77,19 @@ for _name, _size in BODY_FIELDS:
     _start += _size
 BODY_BLOCK_SIZE = _start
 BASE_BLOCK_SIZE = sum(size for _, size in BASE_FIELDS)
-_RESIDUAL_SOURCES = np.concatenate(
-    [np.arange(*_BODY_OFFSETS[name]) for name in RESIDUAL_FIELDS]
-)
-_GATHER = np.concatenate([np.arange(BASE_BLOCK_SIZE), _RESIDUAL_SOURCES])
 
 
-def split_precision(base_blocks: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """float32 body blocks (base fields, then residuals) from float64 base blocks (n, base).
+def split_precision(full: np.ndarray, residual_mask: np.ndarray) -> np.ndarray:
+    """The float32 observation from its float64 values, residuals included.
 
-    ``out`` (float32, shape (n, BODY_BLOCK_SIZE)) is filled in place when given: the env
-    writes straight into its observation buffer (this runs every control step).
+    ``full`` is laid out like the observation, each residual slot holding a copy of its
+    source value; ``residual_mask`` (:attr:`ObservationLayout.residual_mask`) marks those
+    slots. One cast and one masked subtraction: this runs every control step. Returns a fresh
+    array (callers keep old observations).
     """
-    full = base_blocks[:, _GATHER]
-    if out is None:
-        out = np.empty(full.shape, dtype=np.float32)
-    out[...] = full
-    out[:, BASE_BLOCK_SIZE:] = full[:, BASE_BLOCK_SIZE:] - out[:, BASE_BLOCK_SIZE:]
-    return out
+    obs = full.astype(np.float32)
+    np.subtract(full, obs, out=obs, where=residual_mask)
+    return obs
 
 
 @dataclass(frozen=True)
@@ -119,6 +115,16 @@ class ObservationLayout:
     @property
     def size(self) -> int:
         return self.n_bodies * BODY_BLOCK_SIZE + sum(n for _, n in GLOBAL_FIELDS)
+
+    @cached_property
+    def residual_mask(self) -> np.ndarray:
+        """True on every ``*_residual`` entry of the flat observation (for split_precision)."""
+        mask = np.zeros(self.size, dtype=bool)
+        for i in range(self.n_bodies):
+            start = self.body_offset(i)
+            mask[start + BASE_BLOCK_SIZE : start + BODY_BLOCK_SIZE] = True
+        mask.flags.writeable = False
+        return mask
 
     def body_offset(self, body_index: int) -> int:
         if not 0 <= body_index < self.n_bodies:

@@ -190,13 +190,13 @@ class Simulator:
         uids: Sequence[int],
         forces: Sequence[Sequence[float]],
         torques: Sequence[Sequence[float]] | None,
-        com_positions: Sequence[Sequence[Sequence[float]]],
+        com_paths: Sequence[Sequence[Sequence[float]]],
         prop_moves: Sequence[Sequence[tuple[int, Sequence[float]]]] = (),
     ) -> None:
-        """Run ``len(com_positions)`` simulation steps holding the forces and torques.
+        """Run ``len(com_paths[0])`` simulation steps holding the forces and torques.
 
         They are re-applied on every substep because PyBullet clears them after each step.
-        A WORLD_FRAME force acts at the given world point, so ``com_positions[k][i]`` must be
+        A WORLD_FRAME force acts at the given world point, so ``com_paths[i][k]`` must be
         body ``i``'s centre of mass before substep ``k`` (anything else adds a torque); the
         env predicts it from the integrator instead of reading it back (API calls are the
         cost). ``prop_moves[k]`` lists the kinematic props to place before substep ``k``.
@@ -205,12 +205,12 @@ class Simulator:
         apply_force, apply_torque = pb.applyExternalForce, pb.applyExternalTorque
         step, reset, world = pb.stepSimulation, pb.resetBasePositionAndOrientation, pb.WORLD_FRAME
         identity = (0.0, 0.0, 0.0, 1.0)
-        for k, positions in enumerate(com_positions):
+        for k in range(len(com_paths[0])):
             if prop_moves:
                 for uid, pos in prop_moves[k]:
                     reset(uid, pos, identity, physicsClientId=c)
             for i, uid in enumerate(uids):
-                apply_force(uid, -1, forces[i], positions[i], world, physicsClientId=c)
+                apply_force(uid, -1, forces[i], com_paths[i][k], world, physicsClientId=c)
                 if torques is not None:
                     apply_torque(uid, -1, torques[i], world, physicsClientId=c)
             step(physicsClientId=c)

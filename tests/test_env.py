@@ -14,6 +14,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
 from sgc_env.envs import SGCEnv
+from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS
 from sgc_env.scenario import Body, Goal, Scenario, load_scenario
 
 
@@ -184,6 +185,37 @@ def test_observation_contract_fields():
     assert obs[lay.body_slice(0, "position_flags")].tolist() == [1.0, 0.0]
     assert obs[lay.body_slice(0, "orientation_flags")].tolist() == [1.0, 0.0]
     assert obs[lay.global_slice("time")][0] == 0.0
+
+
+def test_residuals_recover_doubles_and_observations_are_not_reused():
+    env = SGCEnv("three_rods")
+    obs, _ = env.reset()
+    lay = env.layout
+    assert RESIDUAL_FIELDS == (  # the order SGCEnv._observe writes the residual sources in
+        "position_deviation", "point_velocity", "orientation", "angular_velocity",
+        "linear_velocity", "orientation_deviation", "position_time_left",
+        "orientation_time_left", "point_offset",
+    )  # fmt: skip
+    mask = lay.residual_mask
+    assert mask.sum() == lay.n_bodies * (lay.body_block_size - BASE_BLOCK_SIZE)
+    assert all(mask[lay.body_slice(i, "point_offset_residual")].all() for i in range(lay.n_bodies))
+    assert not mask[lay.global_slice("time")].any()
+    rng = np.random.default_rng(0)
+    kept = [(obs, obs.copy())]
+    for _ in range(30):
+        obs, _, _, _, info = env.step(rng.uniform(-0.2, 0.2, env.action_space.shape))
+        kept.append((obs, obs.copy()))
+        for i in range(lay.n_bodies):
+            for field, exact in (
+                ("position_deviation", info["position_deviation"][i]),
+                ("point_velocity", info["point_velocity"][i]),
+                ("orientation", info["body_orientation"][i]),
+                ("orientation_deviation", info["orientation_deviation"][i]),
+            ):
+                value = obs[lay.body_slice(i, field)].astype(np.float64)
+                value += obs[lay.body_slice(i, f"{field}_residual")]
+                np.testing.assert_allclose(value, exact, rtol=1e-14, atol=1e-15)
+    assert all(np.array_equal(returned, copy) for returned, copy in kept)
 
 
 def test_goal_ticks_advance_goals_and_report_errors():

@@ -84,7 +84,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.observation import BASE_BLOCK_SIZE, ObservationLayout, split_precision
+from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, split_precision
 from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
@@ -112,6 +112,8 @@ _DEV = _BLOCK.body_slice(0, "position_deviation").start  # then point_velocity, 
 _PTL = _BLOCK.body_slice(0, "position_time_left").start
 _ODEV = _BLOCK.body_slice(0, "orientation_deviation").start  # then orientation time left
 _OTL = _BLOCK.body_slice(0, "orientation_time_left").start
+_ZERO3 = (0.0, 0.0, 0.0)
+_ZERO6 = (0.0,) * 6
 
 
 @dataclass(frozen=True)
@@ -208,6 +210,8 @@ class SGCEnv(gym.Env):
         self.action_space = gym.spaces.Box(-1.0, 1.0, (per * self._n,), np.float32)
         self._action_shape = self.action_space.shape
         self.layout = ObservationLayout(self._n, tuple(b.name for b in base.bodies))
+        self._obs_size = self.layout.size
+        self._residual_mask = self.layout.residual_mask
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
@@ -418,46 +422,49 @@ class SGCEnv(gym.Env):
             self._states = [
                 get_p(uid, physicsClientId=c) + get_v(uid, physicsClientId=c) for uid in self._uids
             ]
-        states = self._states
-        n = self._n
         t = self._tick * self.dt
+        s_offset, s_pos, s_ori = self._s_offset, self._s_pos, self._s_ori
+        has_pos, has_ori, phis = self._has_pos, self._has_ori, self._phi
         flat: list[float] = []
         points = []
         cost = 0.0
         ok = True
         spin = 0.0
         lo, hi = self._ws_low, self._ws_high
-        for i, (pos, orn, lin, ang) in enumerate(states):
-            offset = self._s_offset[i]
-            if offset == (0.0, 0.0, 0.0):
+        for i, (pos, orn, lin, ang) in enumerate(self._states):
+            offset = s_offset[i]
+            if offset == _ZERO3:
                 r, p = offset, pos
             else:
                 r = rotate(orn, offset)
                 p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
             points.append(p)
-            if self._has_pos[i]:
+            wx, wy, wz = ang
+            if has_pos[i]:
                 nail = self._s_nail[i]
-                wx, wy, wz = ang
                 dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
-                dyn = (
+                dev = (
                     dx, dy, dz, lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
-                    lin[2] + wx * r[1] - wy * r[0], self._s_ptime[i] - t,
+                    lin[2] + wx * r[1] - wy * r[0],
                 )  # fmt: skip
+                ptl = self._s_ptime[i] - t
                 cost += math.sqrt(dx * dx + dy * dy + dz * dz) * self._s_pscale[i]
             else:
-                dyn = (0.0,) * 7
-            if self._has_ori[i]:
-                phi = unwrap_rotvec(
-                    rotvec_from_quat(quat_conj_mul(orn, self._s_quat[i])), self._phi[i]
-                )
-                self._phi[i] = phi
-                odyn = (*phi, self._s_otime[i] - t)
+                dev, ptl = _ZERO6, 0.0
+            if has_ori[i]:
+                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, self._s_quat[i])), phis[i])
+                phis[i] = phi
+                otl = self._s_otime[i] - t
                 cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * self._s_oscale[i]
             else:
-                odyn = (0.0, 0.0, 0.0, 0.0)
-            flat += pos + orn + lin + ang + offset + dyn + self._s_pos[i] + odyn + self._s_ori[i]
-            ax, ay, az = ang
-            spin = max(spin, ax * ax + ay * ay + az * az)
+                phi, otl = _ZERO3, 0.0
+            # BODY_FIELDS order: the residual slots repeat their sources in RESIDUAL_FIELDS
+            # order (pinned by a test) for split_precision.
+            flat += [
+                *pos, *orn, *lin, *ang, *offset, *dev, ptl, *s_pos[i], *phi, otl, *s_ori[i],
+                *dev, *orn, *ang, *lin, *phi, ptl, otl, *offset,
+            ]  # fmt: skip
+            spin = max(spin, wx * wx + wy * wy + wz * wz)
             if ok:
                 vx, vy, vz = lin
                 # NaN fails every comparison, so this also catches non-finite states; with the
@@ -472,15 +479,12 @@ class SGCEnv(gym.Env):
             flat += p
         flat += self._applied
         # One array holds the observation, then point positions, forces and torques, so the
-        # info entries are views instead of separate allocations.
-        arr = np.array(flat)
-        size = n * BASE_BLOCK_SIZE + 1
-        self._block = arr[: size - 1].reshape(n, BASE_BLOCK_SIZE)
-        obs = np.empty(self.layout.size, dtype=np.float32)
-        split_precision(self._block, obs[:-1].reshape(n, -1))
-        obs[-1] = t
-        self._obs = obs
-        self._tail = arr[size:].reshape(3, n, 3)
+        # info entries are views instead of separate allocations (a fresh one every step).
+        arr = np.array(flat, dtype=np.float64)
+        size = self._obs_size
+        self._obs = split_precision(arr[:size], self._residual_mask)
+        self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
+        self._tail = arr[size:].reshape(3, self._n, 3)
         self._point_pos = points
         self._cost = cost
         self._failed = not ok
@@ -494,10 +498,11 @@ class SGCEnv(gym.Env):
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError(f"action contains non-finite values: {values}")
         values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
-        per = 6 if self.use_torque else 3
+        use_torque = self.use_torque
+        per = 6 if use_torque else 3
         gx, gy, gz = self._gravity
-        forces, torques, applied_f, applied_t = [], [], [], []
-        com_positions: list[list[tuple[float, float, float]]] = [[] for _ in self._substep_coef]
+        coef = self._substep_coef
+        forces, torques, applied_f, applied_t, paths = [], [], [], [], []
         for i, (pos, _, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
@@ -505,7 +510,7 @@ class SGCEnv(gym.Env):
             f = (fx, fy, fz)
             forces.append(f)
             applied_f += f
-            if per == 6:
+            if use_torque:
                 tl = self._tlimit[i]
                 tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
                 torques.append(tq)
@@ -515,8 +520,12 @@ class SGCEnv(gym.Env):
             x0, y0, z0 = pos
             vx, vy, vz = lin
             # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
-            for row, (kh, c) in zip(com_positions, self._substep_coef, strict=True):
-                row.append((x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az))
+            paths.append(
+                [
+                    (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
+                    for kh, c in coef
+                ]
+            )
         moves: list[list[tuple[int, tuple[float, float, float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
@@ -525,9 +534,7 @@ class SGCEnv(gym.Env):
                 list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
                 for k in range(self.substeps)
             ]
-        self.sim.step_bodies(
-            self._uids, forces, torques if self.use_torque else None, com_positions, moves
-        )
+        self.sim.step_bodies(self._uids, forces, torques if use_torque else None, paths, moves)
         self._applied = applied_f + (applied_t or self._zeros3n)
         self._tick += 1
         self._observe()
@@ -588,7 +595,7 @@ class SGCEnv(gym.Env):
         return events
 
     def _reward(self, values: list[float], events: list[dict[str, Any]]) -> float:
-        reward = -self._cost / self._n - 0.01 * sum(x * x for x in values) / len(values)
+        reward = -self._cost / self._n - 0.01 * sum([x * x for x in values]) / len(values)
         for ev in events:
             if ev["position_error"] is not None:
                 reward += math.exp(-ev["position_error"] / 0.01)
