@@ -16,6 +16,7 @@ Both keep a little per-episode state (one slot per sub-env of a vector env) and 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 from typing import Any
@@ -101,6 +102,27 @@ def new_episode_flags(episode_start: Any, n: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(episode_start, dtype=bool).reshape(-1), (n,))
 
 
+def predict_per_env(
+    observation: Any,
+    episode_start: Any,
+    row_action: Callable[[int, np.ndarray, bool], np.ndarray],
+) -> np.ndarray:
+    """``row_action(env_index, observation_row, episode_start)`` over one observation or a batch.
+
+    Vector envs hand policies a batch of rows, one per sub-env; a policy with per-episode state
+    keeps it per row index.
+    """
+    obs = np.asarray(observation)
+    batch = obs.ndim == 2
+    rows = obs if batch else obs[None]
+    starts = new_episode_flags(episode_start, rows.shape[0])
+    actions = [
+        row_action(i, row, bool(start))
+        for i, (row, start) in enumerate(zip(rows, starts, strict=True))
+    ]
+    return np.stack(actions) if batch else actions[0]
+
+
 class _StatefulPolicy:
     """``predict`` over one observation or a batch, with one state slot per sub-env."""
 
@@ -119,15 +141,7 @@ class _StatefulPolicy:
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
         """Action(s) for one flat observation or a batch; ``state`` is passed through."""
-        obs = np.asarray(observation)
-        batch = obs.ndim == 2
-        rows = obs if batch else obs[None]
-        starts = new_episode_flags(episode_start, rows.shape[0])
-        actions = [
-            self._row_action(i, row, bool(s))
-            for i, (row, s) in enumerate(zip(rows, starts, strict=True))
-        ]
-        return (np.stack(actions) if batch else actions[0]), state
+        return predict_per_env(observation, episode_start, self._row_action), state
 
     def _row_action(self, index: int, observation: np.ndarray, episode_start: bool) -> np.ndarray:
         layout_size = self.model.layout.size

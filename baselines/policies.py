@@ -19,8 +19,8 @@ from baselines.comparison_policies import (
     DynamicConstraintsController,
     MinimumJerkController,
     episode_model,
-    new_episode_flags,
     observation_tick,
+    predict_per_env,
 )
 from baselines.expert import SGCExpert
 
@@ -66,10 +66,10 @@ class RandomPolicy:
 class EpisodeExpert:
     """:class:`SGCExpert` with its env model re-read at every episode start, per sub-env.
 
-    The expert reads masses and force limits once, at construction; random-scenario envs
-    redraw them on every reset, so a stale model under- or over-drives the body. This wrapper
-    keeps one expert per sub-env and rebuilds it when an episode starts (``episode_start``
-    or an observation at tick 0).
+    The expert reads masses, inertias and force limits once, at construction; a scenario
+    swapped through ``reset(options={"scenario": ...})`` can change them, and a stale model
+    under- or over-drives the body. This wrapper keeps one expert per sub-env and rebuilds it
+    when an episode starts (``episode_start`` or an observation at tick 0).
     """
 
     def __init__(self, env: Any) -> None:
@@ -84,16 +84,12 @@ class EpisodeExpert:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        obs = np.asarray(observation)
-        batch = obs.ndim == 2
-        rows = obs if batch else obs[None]
-        starts = new_episode_flags(episode_start, rows.shape[0])
-        actions = []
-        for i, (row, start) in enumerate(zip(rows, starts, strict=True)):
+        def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
                 self._experts[i] = SGCExpert(model=episode_model(self.env, i))
-            actions.append(self._experts[i].action(row))
-        return (np.stack(actions) if batch else actions[0]), state
+            return self._experts[i].action(row)
+
+        return predict_per_env(observation, episode_start, row_action), state
 
 
 def policy_label(spec: str) -> str:
