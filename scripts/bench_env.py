@@ -101,6 +101,18 @@ def reset_us(env: gym.Env, n: int, **kwargs) -> float:
     return (time.perf_counter() - t0) / n * 1e6
 
 
+def fixed_env(env_id: str) -> tuple[SGCEnv, SGCEnv]:
+    """The env as registered (reset at seed 0) and a plain SGCEnv on that same scenario.
+
+    Timing the fixed one keeps random-scenario draws out of the step and reset figures.
+    """
+    made = gym.make(env_id).unwrapped
+    made.reset(seed=0)
+    fixed = SGCEnv(made.scenario)
+    fixed.reset()
+    return made, fixed
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=3000)
@@ -114,10 +126,7 @@ def main() -> None:
     print(header)
     print("-" * len(header))
     for env_id in sgc_env.ENV_IDS:
-        made = gym.make(env_id).unwrapped
-        made.reset(seed=0)
-        fixed = SGCEnv(made.scenario)
-        fixed.reset()
+        made, fixed = fixed_env(env_id)
         bare = BareLoop(fixed)
         action = hover_action(fixed)
         chunk = max(args.steps // args.rounds, 1)

@@ -30,10 +30,9 @@ import numpy as np
 
 import sgc_env  # noqa: F401  (registers the env ids)
 from baselines.expert import GOAL_TICK_SLACK, SGCExpert
-from sgc_env.envs import SGCEnv
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_env import BareLoop, env_step_us, hover_action  # noqa: E402
+from bench_env import BareLoop, env_step_us, fixed_env, hover_action  # noqa: E402
 
 ENV_IDS = ("SGCRod-v0", "SGCThreeRods-v0")
 
@@ -89,10 +88,7 @@ def time_actions(expert: SGCExpert, observations: list[np.ndarray], repeats: int
 
 def physics_us(env_id: str, steps: int, rounds: int) -> tuple[float, float, int]:
     """Best-of-rounds microseconds per control step: bare PyBullet loop and env.step."""
-    made = gym.make(env_id).unwrapped
-    made.reset(seed=0)
-    fixed = SGCEnv(made.scenario)
-    fixed.reset()
+    made, fixed = fixed_env(env_id)
     bare = BareLoop(fixed)
     action = hover_action(fixed)
     chunk = max(steps // rounds, 1)

@@ -93,6 +93,7 @@ from sgc_env.simulator import Simulator, pybullet
 
 from .tracks import (
     BodyTracks,
+    Track,
     compile_tracks,
     quat_conj_mul,
     rotate,
@@ -139,6 +140,17 @@ def _geometry(s: Scenario) -> tuple:
         tuple((b.name, b.shape, b.size, b.mass, b.color, b.collisions) for b in s.bodies),
         tuple((p.name, p.shape, p.size, p.color, p.collisions) for p in s.props),
     )
+
+
+def _course_fields(track: Track, k: int) -> tuple[float, ...]:
+    """The 13 static observation entries of a track's course ``k``: course start and duration,
+    next start and duration, end velocity (last goal only) and the two flags."""
+    last = k == track.size - 1
+    end = tuple(track.end_velocity) if last else (0.0, 0.0, 0.0)
+    return (
+        *track.course_start[k].tolist(), float(track.durations[k]),
+        *track.next_start[k].tolist(), float(track.next_duration[k]), *end, 1.0, float(last),
+    )  # fmt: skip
 
 
 class SGCEnv(gym.Env):
@@ -354,15 +366,10 @@ class SGCEnv(gym.Env):
         tr = self.tracks[i].position
         if tr is not None:
             k = self._pos_idx[i]
-            last = k == tr.size - 1
-            end_v = tuple(tr.end_velocity) if last else (0.0, 0.0, 0.0)
             self._s_offset[i] = tuple(tr.points[k].tolist())
             self._s_nail[i] = tuple(tr.targets[k].tolist())
             self._s_ptime[i] = float(tr.times[k])
-            self._s_pos[i] = (
-                *tr.course_start[k].tolist(), float(tr.durations[k]), *tr.next_start[k].tolist(),
-                float(tr.next_duration[k]), *end_v, 1.0, float(last),
-            )  # fmt: skip
+            self._s_pos[i] = _course_fields(tr, k)
             self._s_pscale[i] = 1.0 / max(float(np.linalg.norm(tr.course_start[k])), 0.1)
             self._goal_index = _with(self._goal_index, i, int(tr.goal_ids[k]))
         else:
@@ -371,14 +378,9 @@ class SGCEnv(gym.Env):
         to = self.tracks[i].orientation
         if to is not None:
             k = self._ori_idx[i]
-            last = k == to.size - 1
-            end_w = tuple(to.end_velocity) if last else (0.0, 0.0, 0.0)
             self._s_quat[i] = tuple(to.targets[k].tolist())
             self._s_otime[i] = float(to.times[k])
-            self._s_ori[i] = (
-                *to.course_start[k].tolist(), float(to.durations[k]), *to.next_start[k].tolist(),
-                float(to.next_duration[k]), *end_w, 1.0, float(last),
-            )  # fmt: skip
+            self._s_ori[i] = _course_fields(to, k)
             self._s_oscale[i] = 1.0 / max(float(np.linalg.norm(to.course_start[k])), 0.5)
             self._ori_goal_index = _with(self._ori_goal_index, i, int(to.goal_ids[k]))
         else:
