@@ -6,7 +6,7 @@ and one getBasePositionAndOrientation + getBaseVelocity per body per control ste
 the mean of ``env.reset()`` on the unwrapped env with a fixed scenario (random-scenario envs
 are also timed with their per-reset scenario draw).
 
-    .venv/bin/python scripts/bench_env.py [--steps 3000] [--resets 2000]
+    .venv/bin/python scripts/bench_env.py [--steps 10000] [--resets 1000] [--rounds 20]
 """
 
 from __future__ import annotations
@@ -115,9 +115,9 @@ def fixed_env(env_id: str) -> tuple[SGCEnv, SGCEnv]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=3000)
-    parser.add_argument("--resets", type=int, default=2000)
-    parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds; best is kept")
+    parser.add_argument("--steps", type=int, default=10000)
+    parser.add_argument("--resets", type=int, default=1000)
+    parser.add_argument("--rounds", type=int, default=20, help="interleaved rounds; best is kept")
     args = parser.parse_args()
     header = (
         f"{'id':18} {'env steps/s':>12} {'bare steps/s':>13} {'ratio':>6} "

@@ -6,8 +6,11 @@ so that nobody hard-codes offsets.
 
 from __future__ import annotations
 
+import operator
+import struct
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 
 import numpy as np
 
@@ -19,7 +22,7 @@ __all__ = [
     "GLOBAL_FIELDS",
     "RESIDUAL_FIELDS",
     "ObservationLayout",
-    "split_precision",
+    "float32_residuals",
 ]
 
 BASE_FIELDS: tuple[tuple[str, int], ...] = (
@@ -79,17 +82,27 @@ BODY_BLOCK_SIZE = _start
 BASE_BLOCK_SIZE = sum(size for _, size in BASE_FIELDS)
 
 
-def split_precision(full: np.ndarray, residual_mask: np.ndarray) -> np.ndarray:
-    """The float32 observation from its float64 values, residuals included.
+def float32_residuals(values: Sequence[float]) -> list[float]:
+    """``x - float32(x)`` for every value: what storing ``x`` as float32 loses.
 
-    ``full`` is laid out like the observation, each residual slot holding a copy of its
-    source value; ``residual_mask`` (:attr:`ObservationLayout.residual_mask`) marks those
-    slots. One cast and one masked subtraction: this runs every control step. Returns a fresh
-    array (callers keep old observations).
+    Stored as float32 again, the residual recovers the double to ~1e-15 relative. Computed on
+    plain floats because it runs every control step on about two dozen values: one struct
+    round trip rounds them all to float32 (the C cast numpy's ``astype`` uses), about four
+    times cheaper than the mixed-dtype numpy subtraction. Values too large for float32 fall
+    back to numpy, which rounds them to infinity like the observation itself.
     """
-    obs = full.astype(np.float32)
-    np.subtract(full, obs, out=obs, where=residual_mask)
-    return obs
+    fmt = _float32_struct(len(values))
+    try:
+        rounded: Sequence[float] = fmt.unpack(fmt.pack(*values))
+    except OverflowError:
+        with np.errstate(over="ignore"):
+            rounded = np.asarray(values, dtype=np.float64).astype(np.float32).tolist()
+    return list(map(operator.sub, values, rounded))
+
+
+@cache
+def _float32_struct(n: int) -> struct.Struct:
+    return struct.Struct(f"{n}f")
 
 
 @dataclass(frozen=True)
@@ -118,7 +131,7 @@ class ObservationLayout:
 
     @cached_property
     def residual_mask(self) -> np.ndarray:
-        """True on every ``*_residual`` entry of the flat observation (for split_precision)."""
+        """True on every ``*_residual`` entry of the flat observation."""
         mask = np.zeros(self.size, dtype=bool)
         for i in range(self.n_bodies):
             start = self.body_offset(i)

@@ -18,7 +18,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BodyHandle", "Simulator", "pybullet"]
+__all__ = ["BodyHandle", "Drive", "Simulator", "pybullet"]
+
+Drive = tuple[int, Sequence[float], Sequence[float] | None, Sequence[Sequence[float]]]
+"""One body's control period: (uid, force, torque or None, CoM before each substep)."""
 
 
 @contextlib.contextmanager
@@ -187,32 +190,30 @@ class Simulator:
 
     def step_bodies(
         self,
-        uids: Sequence[int],
-        forces: Sequence[Sequence[float]],
-        torques: Sequence[Sequence[float]] | None,
-        com_paths: Sequence[Sequence[Sequence[float]]],
+        drives: Sequence[Drive],
         prop_moves: Sequence[Sequence[tuple[int, Sequence[float]]]] = (),
     ) -> None:
-        """Run ``len(com_paths[0])`` simulation steps holding the forces and torques.
+        """Run ``len(path)`` simulation steps holding each body's force and torque.
 
-        They are re-applied on every substep because PyBullet clears them after each step.
-        A WORLD_FRAME force acts at the given world point, so ``com_paths[i][k]`` must be
-        body ``i``'s centre of mass before substep ``k`` (anything else adds a torque); the
-        env predicts it from the integrator instead of reading it back (API calls are the
-        cost). ``prop_moves[k]`` lists the kinematic props to place before substep ``k``.
+        ``drives`` holds one ``(uid, force, torque or None, path)`` per body. The force and
+        torque are re-applied on every substep because PyBullet clears them after each step.
+        A WORLD_FRAME force acts at the given world point, so ``path[k]`` must be the body's
+        centre of mass before substep ``k`` (anything else adds a torque); the env predicts
+        it from the integrator instead of reading it back (API calls are the cost).
+        ``prop_moves[k]`` lists the kinematic props to place before substep ``k``.
         """
         pb, c = pybullet, self.client
         apply_force, apply_torque = pb.applyExternalForce, pb.applyExternalTorque
         step, reset, world = pb.stepSimulation, pb.resetBasePositionAndOrientation, pb.WORLD_FRAME
         identity = (0.0, 0.0, 0.0, 1.0)
-        for k in range(len(com_paths[0])):
+        for k in range(len(drives[0][3])):
             if prop_moves:
                 for uid, pos in prop_moves[k]:
                     reset(uid, pos, identity, physicsClientId=c)
-            for i, uid in enumerate(uids):
-                apply_force(uid, -1, forces[i], com_paths[i][k], world, physicsClientId=c)
-                if torques is not None:
-                    apply_torque(uid, -1, torques[i], world, physicsClientId=c)
+            for uid, force, torque, path in drives:
+                apply_force(uid, -1, force, path[k], world, physicsClientId=c)
+                if torque is not None:
+                    apply_torque(uid, -1, torque, world, physicsClientId=c)
             step(physicsClientId=c)
 
     def save_state(self) -> int:

@@ -14,7 +14,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
 from sgc_env.envs import SGCEnv
-from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS
+from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS, float32_residuals
 from sgc_env.scenario import Body, Goal, Scenario, load_scenario
 
 
@@ -216,6 +216,20 @@ def test_residuals_recover_doubles_and_observations_are_not_reused():
                 value += obs[lay.body_slice(i, f"{field}_residual")]
                 np.testing.assert_allclose(value, exact, rtol=1e-14, atol=1e-15)
     assert all(np.array_equal(returned, copy) for returned, copy in kept)
+
+
+@pytest.mark.parametrize("extremes", [False, True])
+def test_float32_residuals_are_what_a_float32_cast_loses(extremes):
+    rng = np.random.default_rng(3)
+    values = (rng.normal(size=200) * 10.0 ** rng.integers(-40, 38, size=200)).tolist()
+    values += [0.0, -0.0, 1e-320, math.inf, -math.inf, math.nan]
+    if extremes:  # too large for float32: the struct path overflows, numpy rounds to inf
+        values += [3.5e38, -1e39, 1e300]
+    full = np.array(values)
+    with np.errstate(over="ignore", invalid="ignore"):
+        expected = full - full.astype(np.float32).astype(np.float64)
+    got = np.array(float32_residuals(values))
+    assert got.tobytes() == expected.tobytes()
 
 
 def test_goal_ticks_advance_goals_and_report_errors():

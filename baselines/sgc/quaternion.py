@@ -11,7 +11,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-__all__ = ["conjugate", "exp", "exp_normalized", "log", "mul", "rotate", "to_matrix"]
+__all__ = [
+    "conjugate", "exp", "exp_normalized", "log", "mul", "mul_conjugate", "rotate", "to_matrix",
+]  # fmt: skip
 
 Quat = tuple[float, float, float, float]
 Vec3 = tuple[float, float, float]
@@ -26,6 +28,21 @@ def mul(a: Sequence[float], b: Sequence[float]) -> Quat:
         aw * by - ax * bz + ay * bw + az * bx,
         aw * bz + ax * by - ay * bx + az * bw,
         aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def mul_conjugate(a: Sequence[float], b: Sequence[float]) -> Quat:
+    """``a * conj(b)``: the rotation ``R_a R_b^T``, bit for bit ``mul(a, conjugate(b))``.
+
+    Written out because the env evaluates it for every body on every control step.
+    """
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        -aw * bx + ax * bw - ay * bz + az * by,
+        -aw * by + ax * bz + ay * bw - az * bx,
+        -aw * bz - ax * by + ay * bx + az * bw,
+        aw * bw + ax * bx + ay * by + az * bz,
     )
 
 

@@ -76,6 +76,7 @@ plain reset).
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -84,12 +85,12 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, split_precision
+from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
-from sgc_env.simulator import Simulator, pybullet
+from sgc_env.simulator import Drive, Simulator, pybullet
 
 from .tracks import (
     BodyTracks,
@@ -109,10 +110,18 @@ SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not termin
 
 # Offsets inside a body block (see sgc_env.observation.BODY_FIELDS).
 _BLOCK = ObservationLayout(1)
-_DEV = _BLOCK.body_slice(0, "position_deviation").start  # then point_velocity, time left
-_PTL = _BLOCK.body_slice(0, "position_time_left").start
-_ODEV = _BLOCK.body_slice(0, "orientation_deviation").start  # then orientation time left
-_OTL = _BLOCK.body_slice(0, "orientation_time_left").start
+_DEV = _BLOCK.body_slice(0, "position_deviation").start
+# Per-body columns of the (bodies, block) record that info hands out as views; built once
+# because constructing the index tuples costs as much as the slicing itself.
+_COL_DEV = np.s_[:, _DEV : _DEV + 3]
+_COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
+_COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
+_COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
+_COL_OTL = np.s_[:, _BLOCK.body_slice(0, "orientation_time_left").start]
+_COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
+_COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
+_COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
+_COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
 _ZERO3 = (0.0, 0.0, 0.0)
 _ZERO6 = (0.0,) * 6
 
@@ -223,7 +232,9 @@ class SGCEnv(gym.Env):
         self._action_shape = self.action_space.shape
         self.layout = ObservationLayout(self._n, tuple(b.name for b in base.bodies))
         self._obs_size = self.layout.size
-        self._residual_mask = self.layout.residual_mask
+        # The observation's doubles (residual slots hold residuals), then point positions,
+        # forces and torques: packed into one buffer per step (see _observe).
+        self._record = struct.Struct(f"{self.layout.size + 9 * self._n}d")
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
@@ -367,6 +378,7 @@ class SGCEnv(gym.Env):
         if tr is not None:
             k = self._pos_idx[i]
             self._s_offset[i] = tuple(tr.points[k].tolist())
+            self._s_offset_residual[i] = float32_residuals(self._s_offset[i])
             self._s_nail[i] = tuple(tr.targets[k].tolist())
             self._s_ptime[i] = float(tr.times[k])
             self._s_pos[i] = _course_fields(tr, k)
@@ -374,6 +386,7 @@ class SGCEnv(gym.Env):
             self._goal_index = _with(self._goal_index, i, int(tr.goal_ids[k]))
         else:
             self._s_offset[i] = (0.0, 0.0, 0.0)
+            self._s_offset_residual[i] = [0.0, 0.0, 0.0]
             self._s_pos[i] = zeros13
         to = self.tracks[i].orientation
         if to is not None:
@@ -401,6 +414,7 @@ class SGCEnv(gym.Env):
     def _init_caches(self) -> None:
         n = self._n
         self._s_offset: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
+        self._s_offset_residual: list[list[float]] = [[0.0, 0.0, 0.0]] * n
         self._s_nail: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
         self._s_quat: list[tuple[float, ...]] = [(0.0, 0.0, 0.0, 1.0)] * n
         self._s_ptime = [0.0] * n
@@ -415,9 +429,10 @@ class SGCEnv(gym.Env):
     def _observe(self, read: bool = True) -> None:
         """Read every body once and build the observation, deviations and failure flags.
 
-        Pure-Python arithmetic on tuples and a single array construction: for a few bodies
-        that is several times cheaper than numpy calls on 3-vectors. ``read=False`` rebuilds
-        from the last read (after a goal switch) without calling PyBullet again.
+        Pure-Python arithmetic on tuples, one struct pack into a fresh buffer and one cast:
+        for a few bodies that is several times cheaper than numpy calls on 3-vectors.
+        ``read=False`` rebuilds from the last read (after a goal switch) without calling
+        PyBullet again.
         """
         if read:
             get_p, get_v, c = self._get_pose, self._get_velocity, self.sim.client
@@ -460,11 +475,12 @@ class SGCEnv(gym.Env):
                 cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * self._s_oscale[i]
             else:
                 phi, otl = _ZERO3, 0.0
-            # BODY_FIELDS order: the residual slots repeat their sources in RESIDUAL_FIELDS
-            # order (pinned by a test) for split_precision.
+            # The residual slots follow in RESIDUAL_FIELDS order (pinned by a test); the point
+            # offset's is cached with the goal.
             flat += [
                 *pos, *orn, *lin, *ang, *offset, *dev, ptl, *s_pos[i], *phi, otl, *s_ori[i],
-                *dev, *orn, *ang, *lin, *phi, ptl, otl, *offset,
+                *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
+                *self._s_offset_residual[i],
             ]  # fmt: skip
             spin = max(spin, wx * wx + wy * wy + wz * wz)
             if ok:
@@ -480,11 +496,13 @@ class SGCEnv(gym.Env):
         for p in points:
             flat += p
         flat += self._applied
-        # One array holds the observation, then point positions, forces and torques, so the
-        # info entries are views instead of separate allocations (a fresh one every step).
-        arr = np.array(flat, dtype=np.float64)
+        # A fresh buffer every step (callers keep old observations and infos); the info
+        # entries are views of it instead of separate allocations.
+        buffer = bytearray(self._record.size)
+        self._record.pack_into(buffer, 0, *flat)
+        arr = np.frombuffer(buffer)
         size = self._obs_size
-        self._obs = split_precision(arr[:size], self._residual_mask)
+        self._obs = arr[:size].astype(np.float32)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
         self._point_pos = points
@@ -499,35 +517,36 @@ class SGCEnv(gym.Env):
         values = a.tolist()
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError(f"action contains non-finite values: {values}")
-        values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
+        if max(values) > 1.0 or min(values) < -1.0:
+            values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
         use_torque = self.use_torque
         per = 6 if use_torque else 3
         gx, gy, gz = self._gravity
         coef = self._substep_coef
-        forces, torques, applied_f, applied_t, paths = [], [], [], [], []
+        drives: list[Drive] = []
+        applied_f: list[float] = []
+        applied_t: list[float] = []
         for i, (pos, _, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
             fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
             f = (fx, fy, fz)
-            forces.append(f)
             applied_f += f
+            tq = None
             if use_torque:
                 tl = self._tlimit[i]
                 tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
-                torques.append(tq)
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
             x0, y0, z0 = pos
             vx, vy, vz = lin
             # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
-            paths.append(
-                [
-                    (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
-                    for kh, c in coef
-                ]
-            )
+            path = [
+                (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
+                for kh, c in coef
+            ]
+            drives.append((self._uids[i], f, tq, path))
         moves: list[list[tuple[int, tuple[float, float, float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
@@ -536,7 +555,7 @@ class SGCEnv(gym.Env):
                 list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
                 for k in range(self.substeps)
             ]
-        self.sim.step_bodies(self._uids, forces, torques if use_torque else None, paths, moves)
+        self.sim.step_bodies(drives, moves)
         self._applied = applied_f + (applied_t or self._zeros3n)
         self._tick += 1
         self._observe()
@@ -606,23 +625,23 @@ class SGCEnv(gym.Env):
         return reward
 
     def _info(self, events: list[dict[str, Any]]) -> dict[str, Any]:
-        block = self._block
+        block, tail = self._block, self._tail
         info: dict[str, Any] = {
             "time": self._tick * self.dt,
             "goal_index": self._goal_index.copy(),
             "orientation_goal_index": self._ori_goal_index.copy(),
-            "position_deviation": block[:, _DEV : _DEV + 3],
-            "orientation_deviation": block[:, _ODEV : _ODEV + 3],
-            "time_to_goal": block[:, _PTL],
-            "orientation_time_to_goal": block[:, _OTL],
-            "body_position": block[:, 0:3],
-            "body_orientation": block[:, 3:7],
-            "body_velocity": block[:, 7:10],
-            "body_angular_velocity": block[:, 10:13],
-            "point_position": self._tail[0],
-            "point_velocity": block[:, _DEV + 3 : _DEV + 6],
-            "force": self._tail[1],
-            "torque": self._tail[2],
+            "position_deviation": block[_COL_DEV],
+            "orientation_deviation": block[_COL_ODEV],
+            "time_to_goal": block[_COL_PTL],
+            "orientation_time_to_goal": block[_COL_OTL],
+            "body_position": block[_COL_POSITION],
+            "body_orientation": block[_COL_ORIENTATION],
+            "body_velocity": block[_COL_VELOCITY],
+            "body_angular_velocity": block[_COL_ANGULAR_VELOCITY],
+            "point_position": tail[0],
+            "point_velocity": block[_COL_POINT_VELOCITY],
+            "force": tail[1],
+            "torque": tail[2],
             "spin_clamped": self._spin_clamped,
         }
         if events:
