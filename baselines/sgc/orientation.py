@@ -20,7 +20,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 __all__ = [
+    "MAX_COURSE_ROTATION",
     "angular_acceleration",
+    "course_pieces",
     "angular_velocity",
     "left_jacobian",
     "left_jacobian_inverse",
@@ -32,6 +34,22 @@ __all__ = [
 ]
 
 _TWO_PI = 2.0 * math.pi
+
+MAX_COURSE_ROTATION = 2.0 * math.pi / 3.0
+"""Longest rotation one orientation course may make; longer relative rotations are split.
+
+``J_l`` is singular on the shell ``|phi| = 2 pi``: a course that starts there cannot carry an
+angular velocity across its axis (the plan would start at the wrong angular velocity), and
+from measured states every rotation near the identity has a representative there only along
+one axis. Planner and env therefore split a somersault into equal sub-rotations about the
+same axis, timed evenly, each one a course of its own.
+"""
+
+
+def course_pieces(rotation_vector) -> int:
+    """How many equal courses a relative rotation is split into (see MAX_COURSE_ROTATION)."""
+    angle = float(np.linalg.norm(np.asarray(rotation_vector, dtype=float)))
+    return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

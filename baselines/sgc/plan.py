@@ -36,6 +36,7 @@ from baselines.sgc.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_v
 from baselines.sgc.frames import solve_course_in_frame as _solve_in_frame
 from baselines.sgc.orientation import (
     angular_acceleration,
+    course_pieces,
     left_jacobian,
     left_jacobian_inverse_apply,
 )
@@ -151,8 +152,13 @@ class PlanSample:
 class _Track:
     """Courses of one track: deviation state at absolute time ``t``."""
 
-    def __init__(self, starts: list[float], ends: list[float], courses: list[FrameCourse],
-                 end_velocity: np.ndarray) -> None:
+    def __init__(
+        self,
+        starts: list[float],
+        ends: list[float],
+        courses: list[FrameCourse],
+        end_velocity: np.ndarray,
+    ) -> None:
         self.starts, self.ends, self.courses = starts, ends, courses
         self.end_velocity = end_velocity
 
@@ -173,12 +179,15 @@ class _Track:
 class BodyPlan:
     """Result of :func:`plan_body`. ``sample(t)`` for ``t >= 0``; ``courses`` diagnostics."""
 
-    def __init__(self, initial, orient_goals, orient_track, pos_goals, pos_track, courses):
+    def __init__(
+        self, initial, orient_goals, orient_track, pos_goals, pos_track, courses, goal_ends=()
+    ):
         self._x0 = initial[0]
         self._r0 = initial[1]
         self._v0 = initial[2]
         self._w0 = initial[3]
-        self._orient_goals = orient_goals  # list of Rotation (resolved goal orientations)
+        self._orient_goals = orient_goals  # Rotation at the end of each orientation course
+        self._goal_ends = list(goal_ends)  # courses that end on a goal (not a somersault piece)
         self._orient = orient_track
         self._pos_goals = pos_goals  # list of (nail, point)
         self._pos = pos_track
@@ -186,7 +195,7 @@ class BodyPlan:
 
     def goal_orientations(self) -> list[np.ndarray]:
         """Resolved goal orientations (quaternions xyzw), relative goals composed."""
-        return [r.as_quat() for r in self._orient_goals]
+        return [self._orient_goals[k].as_quat() for k in self._goal_ends]
 
     def _orientation(self, t: float) -> tuple[Rotation, np.ndarray, np.ndarray]:
         if self._orient is None:
@@ -207,8 +216,9 @@ class BodyPlan:
         rot, omega, omega_dot = self._orientation(t)
         if self._pos is None:
             x = self._x0 + self._v0 * t
-            return PlanSample(x, self._v0.copy(), np.zeros(3), rot.as_quat(), omega, omega_dot,
-                              x, self._v0.copy())
+            return PlanSample(
+                x, self._v0.copy(), np.zeros(3), rot.as_quat(), omega, omega_dot, x, self._v0.copy()
+            )
         i, d, dv, da = self._pos.state(t)
         nail, point = self._pos_goals[min(i, len(self._pos_goals) - 1)]
         rr = rot.apply(point)
@@ -241,50 +251,74 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
     return out
 
 
-def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
-    rots: list[Rotation] = []
-    starts: list[np.ndarray] = []
-    prev = r0
+def _orientation_courses(r0, goals, times):
+    """(goal rotation, phi at the course start, end time, goal index) per course.
+
+    A relative rotation longer than ``MAX_COURSE_ROTATION`` becomes equal sub-rotations about
+    its axis, evenly timed, as in the env: a course starting on ``|phi| = 2 pi`` could not
+    carry the angular velocity across its axis.
+    """
+    out = []
+    prev, t_prev = r0, 0.0
     for i, g in enumerate(goals):
         where = f"orientation goal {i}"
         if (g.orientation is None) == (g.relative_rotation is None):
             raise ValueError(f"{where}: give exactly one of orientation and relative_rotation")
-        if g.relative_rotation is not None:
-            rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
-            goal = Rotation.from_rotvec(rel) * prev
-            phi0 = -rel
-        else:
+        if g.relative_rotation is None:
             goal = _quat(g.orientation, where, "orientation")
-            phi0 = (prev * goal.inv()).as_rotvec()
-        rots.append(goal)
-        starts.append(phi0)
-        prev = goal
+            out.append((goal, (prev * goal.inv()).as_rotvec(), times[i], i))
+            prev = goal
+        else:
+            rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
+            m = course_pieces(rel)
+            for j in range(1, m + 1):
+                prev = Rotation.from_rotvec(rel / m) * prev
+                end = times[i] if j == m else t_prev + (times[i] - t_prev) * j / m
+                out.append((prev, -rel / m, end, i))
+        t_prev = times[i]
+    return out
+
+
+def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
+    pieces = _orientation_courses(r0, goals, times)
+    starts = [phi0 for _, phi0, _, _ in pieces]
+    ends = [end for _, _, end, _ in pieces]
     courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
     for i, phi0 in enumerate(starts):
-        T = times[i] - t_prev
+        T = ends[i] - t_prev
         last = i == len(starts) - 1
         nxt = None if last else starts[i + 1]
         v_end, info = course_end_velocity(
-            phi0, nxt, T, None if last else times[i + 1] - times[i],
+            phi0, nxt, T, None if last else ends[i + 1] - ends[i],
             end_velocity=end_w if last else None,
             c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min,
-        )
+        )  # fmt: skip
         course = _solve_in_frame(info.frame, phi0, phi_dot, T, v_end)
         courses.append(course)
-        diags.append(_diag("orientation", i, t_prev, times[i], course, info))
+        diags.append(_diag("orientation", pieces[i][3], t_prev, ends[i], course, info))
         if not last:
             # omega at phi = 0 is v_end
             phi_dot = np.array(left_jacobian_inverse_apply(starts[i + 1], v_end))
-        t_prev = times[i]
-    track = _Track([0.0, *times[:-1]], list(times), courses, courses[-1].state(
-        courses[-1].duration)[1])
-    return rots, track
+        t_prev = ends[i]
+    end_state = courses[-1].state(courses[-1].duration)[1]
+    track = _Track([0.0, *ends[:-1]], ends, courses, end_state)
+    goal_ends = [
+        k for k, piece in enumerate(pieces) if k == len(pieces) - 1 or pieces[k + 1][3] != piece[3]
+    ]
+    return [goal for goal, _, _, _ in pieces], goal_ends, track
 
 
 def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
     return CourseDiagnostics(
-        track, i, t0, t1, course.branches, course.k, info.turn_angle,
-        info.within_paper_assumption, info.rule,
+        track,
+        i,
+        t0,
+        t1,
+        course.branches,
+        course.k,
+        info.turn_angle,
+        info.within_paper_assumption,
+        info.rule,
     )
 
 
@@ -310,9 +344,14 @@ def _plan_position(x0, v0, orientation_at, goals, times, end_v, opts, diags):
             offset_world = rot_i.apply(resolved[i + 1][1] - point)
             nxt = nail - resolved[i + 1][0] + offset_world
         v_end, info = course_end_velocity(
-            d0, nxt, T, None if last else times[i + 1] - times[i],
+            d0,
+            nxt,
+            T,
+            None if last else times[i + 1] - times[i],
             end_velocity=end_v if last else None,
-            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min,
+            c_low=opts.c_low,
+            c_high=opts.c_high,
+            k_min=opts.k_min,
         )
         course = _solve_in_frame(info.frame, d0, dv0, T, v_end)
         courses.append(course)
@@ -352,19 +391,22 @@ def plan_body(
         raise ValueError("no goals: position_goals and orientation_goals are both empty")
     end_v = None if end_velocity is None else _vec(end_velocity, 3, "plan", "end_velocity")
     end_w = (
-        None if end_angular_velocity is None
+        None
+        if end_angular_velocity is None
         else _vec(end_angular_velocity, 3, "plan", "end_angular_velocity")
     )
     p_times = _check_times([g.time for g in position_goals], "position")
     o_times = _check_times([g.time for g in orientation_goals], "orientation")
     diags: list[CourseDiagnostics] = []
-    rots, o_track = [], None
+    rots, goal_ends, o_track = [], [], None
     if orientation_goals:
-        rots, o_track = _plan_orientation(r0, w0, orientation_goals, o_times, end_w, opts, diags)
-    plan = BodyPlan((x0, r0, v0, w0), rots, o_track, [], None, diags)
+        rots, goal_ends, o_track = _plan_orientation(
+            r0, w0, orientation_goals, o_times, end_w, opts, diags
+        )
+    plan = BodyPlan((x0, r0, v0, w0), rots, o_track, [], None, diags, goal_ends)
     if position_goals:
         resolved, p_track = _plan_position(
             x0, v0, plan._orientation, position_goals, p_times, end_v, opts, diags
         )
-        plan = BodyPlan((x0, r0, v0, w0), rots, o_track, resolved, p_track, diags)
+        plan = BodyPlan((x0, r0, v0, w0), rots, o_track, resolved, p_track, diags, goal_ends)
     return plan

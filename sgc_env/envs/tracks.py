@@ -14,9 +14,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from baselines.sgc import quaternion
+from baselines.sgc.orientation import MAX_COURSE_ROTATION, course_pieces
 from sgc_env.scenario import Body, Scenario
 
 __all__ = [
+    "MAX_COURSE_ROTATION",
     "BodyTracks",
     "Track",
     "compile_tracks",
@@ -35,9 +37,8 @@ rotvec_from_quat = quaternion.log
 quat_from_rotvec = quaternion.exp_normalized
 
 
-def quat_conj_mul(a: Sequence[float], b: Sequence[float]) -> tuple[float, float, float, float]:
-    """a * conj(b): the rotation R_a R_b^T."""
-    return quaternion.mul(a, quaternion.conjugate(b))
+quat_conj_mul = quaternion.mul_conjugate
+"""a * conj(b): the rotation R_a R_b^T."""
 
 
 def unwrap_rotvec(
@@ -126,21 +127,10 @@ def _position_track(body: Body, freq: int) -> Track | None:
     return _finish(track)
 
 
-MAX_COURSE_ROTATION = 2.0 * math.pi / 3.0
-"""Longest rotation one orientation course may make; longer relative rotations are split.
-
-A rotation-vector deviation is singular on the shell |phi| = 2 pi (every rotation near the
-identity has a representative there only along one axis), so a somersault given as one
-relative rotation of 2 pi or more cannot be tracked through it from measured states. The env
-splits such a goal into equal sub-rotations about the same axis, timed evenly on the control
-grid, each one a course of its own; only the last reports a goal event.
-"""
-
-
 def _pieces(rel: Sequence[float], t0: float, t1: float, freq: int, where: str):
     """Equal sub-rotations of ``rel`` with their times on the control grid."""
     angle = math.sqrt(sum(c * c for c in rel))
-    m = max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
+    m = course_pieces(rel)
     k0, k1 = round(t0 * freq), round(t1 * freq)
     if k1 - k0 < m:
         raise ValueError(
