@@ -466,6 +466,23 @@ def test_closest_approach_on_segments_is_exact_at_a_hit_with_a_speed_change():
     assert t_scalar != 0.5
 
 
+def test_orientation_closest_approach_is_exact_at_a_hit_with_a_speed_change():
+    # A spin that passes the goal orientation on the tick at t = 1.0, fast before and slow
+    # after: the squared-angle parabola would put the closest approach late.
+    t = (np.arange(120) + 1) * DT
+    angle = np.where(t < 1.0, 4.0, 1.0) * (t - 1.0)
+    quats = Rotation.from_rotvec(np.outer(angle, [0, 1, 0])).as_quat()
+    still = np.zeros((t.size, 3))
+    infos = make_infos(still, still, quats, np.outer(np.gradient(angle, DT), [0, 1, 0]))
+    card = score_body(
+        BodyTrajectory.from_infos(infos, 0, DT), [GoalSpec(1.0, orientation=(0, 0, 0, 1))]
+    )
+    goal = card["orientation_goals"][0]
+    assert abs(goal["closest_offset"]) < 1e-12 and goal["closest_angle"] < 1e-12
+    parabola_time, _ = closest_approach(t, np.abs(angle), 0.5, 1.5)
+    assert abs(parabola_time - 1.0) > 0.1 * DT
+
+
 def test_closest_approach_on_segments_between_ticks():
     times = np.arange(11) / 10.0
     offsets = np.stack([times - 0.537, np.full_like(times, 0.01), np.zeros_like(times)], axis=1)

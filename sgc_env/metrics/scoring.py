@@ -99,6 +99,26 @@ def _position_goal_metrics(
     return out
 
 
+def _closest_orientation(
+    traj: BodyTrajectory, target: Sequence[float], angle: np.ndarray, lo: float, hi: float
+) -> tuple[float, float]:
+    """Closest approach to an orientation goal, refined on the rotation-vector segments.
+
+    The segments next to the best tick are used as for positions (exact at a hit on a tick
+    whatever the angular speeds around it), but only where that tick is within pi/2 of the
+    goal: principal rotation vectors jump near pi, and a segment across the jump would pass
+    near the origin. Farther off, the angle's parabola refinement stands.
+    """
+    inside = sg.in_window(traj.times, lo, hi)
+    if inside.size:
+        k = int(inside[np.argmin(angle[inside])])
+        if angle[k] < math.pi / 2:
+            near = slice(max(k - 1, int(inside[0])), min(k + 2, int(inside[-1]) + 1))
+            offsets = traj.orientation_offset(target)[near]
+            return sg.closest_approach(traj.times[near], offsets, lo, hi)
+    return sg.closest_approach(traj.times, angle, lo, hi)
+
+
 def _orientation_goal_metrics(
     traj: BodyTrajectory, goals: list[GoalSpec], start_time: float, tol: Tolerances
 ) -> list[dict[str, float]]:
@@ -110,7 +130,7 @@ def _orientation_goal_metrics(
         error = float((traj.orientation_at(goal.time) * target.inv()).magnitude())
         if _after_end(traj, goal):
             error = math.nan
-        t_close, d_close = sg.closest_approach(traj.times, err, lo, hi)
+        t_close, d_close = _closest_orientation(traj, goal.orientation, err, lo, hi)
         t_entry = sg.first_entry(traj.times, err, tol.orientation, lo, hi)
         out.append(
             {

@@ -189,3 +189,12 @@ class BodyTrajectory:
         """Angle (rad, in [0, pi]) between each sampled orientation and `target` (xyzw)."""
         goal = Rotation.from_quat(np.asarray(target, dtype=float))
         return (self.rotations() * goal.inv()).magnitude()
+
+    def orientation_offset(self, target: Sequence[float]) -> FloatArray:
+        """Rotation vectors (n, 3) of each sampled orientation relative to `target` (xyzw).
+
+        Principal vectors: continuous wherever the angle stays below pi, which is where a
+        closest approach is refined.
+        """
+        goal = Rotation.from_quat(np.asarray(target, dtype=float))
+        return (self.rotations() * goal.inv()).as_rotvec()
