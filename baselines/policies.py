@@ -2,13 +2,18 @@
 
 Specs: ``expert``, ``dynamic-constraints``, ``minimum-jerk``, ``random``, or the path of a
 Stable-Baselines3 model ``.zip`` (PPO, SAC, TD3, A2C, DDPG; the algorithm is read from the
-saved data, SB3 and torch are imported only then). Every policy has the SB3 signature
+saved data, SB3 and torch are imported only then). A model trained behind ``VecNormalize``
+gets the statistics ``sgc train`` saved beside it (:func:`vecnormalize_path`), so it sees the
+observations it was trained on. Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
 
 from __future__ import annotations
 
 import importlib
+import pickle
+import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -27,11 +32,14 @@ from baselines.expert import SGCExpert
 __all__ = [
     "BUILTIN_POLICIES",
     "EpisodeExpert",
+    "NormalizedPolicy",
     "RandomPolicy",
     "algorithm_from_data",
     "load_sb3_model",
     "make_policy",
     "policy_label",
+    "policy_labels",
+    "vecnormalize_path",
 ]
 
 BUILTIN_POLICIES: tuple[str, ...] = ("expert", "dynamic-constraints", "minimum-jerk", "random")
@@ -92,9 +100,77 @@ class EpisodeExpert:
         return predict_per_env(observation, episode_start, row_action), state
 
 
+class NormalizedPolicy:
+    """``predict`` on raw observations for a model trained behind ``VecNormalize``."""
+
+    def __init__(self, model: Any, vec_normalize: Any) -> None:
+        self.model = model
+        self.vec_normalize = vec_normalize
+
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        obs = self.vec_normalize.normalize_obs(observation)
+        return self.model.predict(obs, state, episode_start, deterministic)
+
+
 def policy_label(spec: str) -> str:
     """Short name for output folders and tables: the spec, or a model file's stem."""
     return spec if spec in BUILTIN_POLICIES else Path(spec).stem
+
+
+def policy_labels(specs: Sequence[str]) -> list[str]:
+    """One distinct label per spec, for specs scored side by side.
+
+    Model files sharing a stem (``a/final_model.zip``, ``b/final_model.zip``) are told apart
+    by as many parent folders as it takes (``a-final_model``), so their outputs do not
+    overwrite each other. A spec given twice is an error.
+    """
+    seen = [s for s in specs if list(specs).count(s) > 1]
+    if seen:
+        raise ValueError(f"policy: {seen[0]!r} is given more than once")
+    labels = [policy_label(s) for s in specs]
+    depth = 1
+    while len(set(labels)) < len(labels):
+        clashing = {label for label in labels if labels.count(label) > 1}
+        labels = [
+            "-".join([*Path(spec).resolve().parent.parts[-depth:], Path(spec).stem])
+            if label in clashing and spec not in BUILTIN_POLICIES
+            else label
+            for spec, label in zip(specs, labels, strict=True)
+        ]
+        depth += 1
+    return labels
+
+
+def vecnormalize_path(model_path: str | Path) -> Path | None:
+    """The ``VecNormalize`` statistics saved with a model by ``sgc train``, if there are any.
+
+    ``final_model.zip``/``best_model.zip`` pair with ``vecnormalize.pkl`` in the same folder;
+    a checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
+    (SB3's ``CheckpointCallback`` names).
+    """
+    path = Path(model_path)
+    checkpoint = re.fullmatch(r"(.*)_(\d+)_steps", path.stem)
+    if checkpoint:
+        stats = path.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps.pkl")
+    else:
+        stats = path.with_name("vecnormalize.pkl")
+    return stats if stats.is_file() else None
+
+
+def _with_saved_normalization(model: Any, path: str | Path) -> Any:
+    stats = vecnormalize_path(path)
+    if stats is None:
+        return model
+    with stats.open("rb") as fh:
+        vec_normalize = pickle.load(fh)  # what VecNormalize.load does, without a venv
+    vec_normalize.training = False
+    return NormalizedPolicy(model, vec_normalize)
 
 
 def algorithm_from_data(data: dict[str, Any]) -> str:
@@ -165,7 +241,7 @@ def make_policy(spec: str, env: Any, seed: int | None = None) -> Any:
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
-        return load_sb3_model(spec, env=env)
+        return _with_saved_normalization(load_sb3_model(spec, env=env), spec)
     raise ValueError(
         f"policy: unknown spec {spec!r}; expected one of {list(BUILTIN_POLICIES)} or the path "
         "of a Stable-Baselines3 model .zip"

@@ -5,12 +5,16 @@ from __future__ import annotations
 import csv
 import importlib.util
 import json
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from baselines.evaluation import GOAL_COLUMNS
 from sgc_env import cli
+
+SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
 
 
 @pytest.fixture(autouse=True)
@@ -61,6 +65,24 @@ def test_evaluate_reports_bad_arguments(tmp_path, capsys):
     assert "unknown spec 'nope'" in capsys.readouterr().err
     assert cli.main(["evaluate", "--env", "Nope-v0", "--out", str(tmp_path)]) == 2
     assert cli.main(["evaluate", "--episodes", "0", "--out", str(tmp_path)]) == 2
+
+
+def test_evaluate_keeps_models_with_the_same_file_name_apart(tmp_path, capsys):
+    shipped = SHIPPED / "ppo_dagger_SGCPoint-v0.zip"
+    specs = []
+    for run in ("run_a", "run_b"):
+        (tmp_path / run).mkdir()
+        specs.append(str(tmp_path / run / "final_model.zip"))
+        shutil.copy(shipped, specs[-1])
+    out = tmp_path / "cmp"
+    argv = ["evaluate", "--env", "SGCPoint-v0", "--policy", ",".join(specs), "--episodes", "1"]
+    assert cli.main([*argv, "--no-plots", "--out", str(out)]) == 0
+    cards = json.loads((out / "scorecard.json").read_text())
+    assert [c["policy"] for c in cards] == ["run_a-final_model", "run_b-final_model"]
+    for label in ("run_a-final_model", "run_b-final_model"):
+        assert (out / "SGCPoint-v0" / label / "goals.csv").is_file()
+    assert cli.main([*argv[:4], f"{specs[0]},{specs[0]}", "--out", str(out)]) == 2
+    assert "given more than once" in capsys.readouterr().err
 
 
 def test_rollout_writes_trajectory_and_figures(tmp_path):

@@ -10,9 +10,12 @@ import sgc_env  # noqa: F401  (registers the env ids)
 from baselines import DynamicConstraintsController, MinimumJerkController, SGCExpert
 from baselines.policies import (
     EpisodeExpert,
+    NormalizedPolicy,
     RandomPolicy,
     algorithm_from_data,
     make_policy,
+    policy_labels,
+    vecnormalize_path,
 )
 from sgc_env.envs.sgc_env import SGCEnv
 from sgc_env.metrics import goals_from_scenario, score_episode
@@ -143,6 +146,47 @@ def test_make_policy_errors(tmp_path):
         make_policy("expert", goal_env)
     assert isinstance(make_policy("random", goal_env, seed=0), RandomPolicy)
     goal_env.close()
+
+
+def test_policy_labels_are_distinct():
+    assert policy_labels(["expert", "a/m.zip", "b/m.zip", "c/x/n.zip", "d/x/n.zip"]) == [
+        "expert", "a-m", "b-m", "c-x-n", "d-x-n",
+    ]  # fmt: skip
+    assert policy_labels(["random", "runs/model.zip"]) == ["random", "model"]
+    with pytest.raises(ValueError, match="'expert' is given more than once"):
+        policy_labels(["expert", "random", "expert"])
+
+
+@pytest.mark.parametrize(
+    ("model", "stats"),
+    [
+        ("final_model.zip", "vecnormalize.pkl"),
+        ("ppo_2048_steps.zip", "ppo_vecnormalize_2048_steps.pkl"),
+    ],
+)
+def test_models_trained_behind_vecnormalize_get_their_statistics(tmp_path, model, stats):
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    env = gym.make("SGCPoint-v0")
+    ppo = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")
+    ppo.save(tmp_path / model)
+    plain = make_policy(str(tmp_path / model), env)
+    assert vecnormalize_path(tmp_path / model) is None and not isinstance(plain, NormalizedPolicy)
+    normalizer = VecNormalize(DummyVecEnv([lambda: gym.make("SGCPoint-v0")]), norm_reward=False)
+    normalizer.obs_rms.mean[:] = 3.0
+    normalizer.obs_rms.var[:] = 4.0
+    normalizer.save(str(tmp_path / stats))
+    policy = make_policy(str(tmp_path / model), env)
+    assert vecnormalize_path(tmp_path / model) == tmp_path / stats
+    assert isinstance(policy, NormalizedPolicy) and not policy.vec_normalize.training
+    obs, _ = env.reset(seed=0)
+    expected, _ = ppo.predict(
+        np.clip((obs - 3.0) / np.sqrt(4.0 + 1e-8), -10, 10), deterministic=True
+    )
+    np.testing.assert_allclose(policy.predict(obs)[0], expected, rtol=1e-6, atol=1e-6)
+    assert not np.allclose(policy.predict(obs)[0], plain.predict(obs)[0])
+    env.close()
 
 
 def _policy_class(module):

@@ -17,28 +17,17 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from baselines.policies import NormalizedPolicy
+
 __all__ = [
     "EVAL_SEED",
     "FreezeActorCallback",
     "HarnessEvalCallback",
-    "NormalizedPolicy",
     "score_key",
 ]
 
 EVAL_SEED = 10_000
 """First held-out evaluation seed; training envs use the run seed and its successors."""
-
-
-class NormalizedPolicy:
-    """``predict`` on raw observations for a model trained behind ``VecNormalize``."""
-
-    def __init__(self, model: Any, vec_normalize: Any) -> None:
-        self.model = model
-        self.vec_normalize = vec_normalize
-
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
-        obs = self.vec_normalize.normalize_obs(observation)
-        return self.model.predict(obs, state, episode_start, deterministic)
 
 
 def _scalar_items(summary: dict[str, Any], prefix: str = "") -> dict[str, float]:

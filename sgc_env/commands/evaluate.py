@@ -150,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from baselines.evaluation import evaluate, json_ready
-    from baselines.policies import policy_label
+    from baselines.policies import policy_labels
     from sgc_env.metrics import Tolerances
 
     console = Console()
@@ -158,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
         console = Console(width=200)
     try:
         policies = _split(args.policy, "expert")
+        labels = policy_labels(policies)
         envs = expand_envs(_split(args.env, "SGCPoint-v0"))
         tolerances = Tolerances(
             args.tolerance_position, args.tolerance_orientation, args.tolerance_time
@@ -168,14 +169,15 @@ def run(args: argparse.Namespace) -> int:
     single = len(policies) == 1 and len(envs) == 1
     summaries = []
     for env_id in envs:
-        for spec in policies:
-            label = policy_label(spec)
+        for spec, label in zip(policies, labels, strict=True):
             if single:
                 out = args.out or Path("runs/evaluate") / env_id / label
             else:
                 out = (args.out or Path("runs/evaluate")) / env_id / label
             try:
-                result = evaluate(spec, env_id, args.episodes, args.seed, tolerances=tolerances)
+                result = evaluate(
+                    spec, env_id, args.episodes, args.seed, tolerances=tolerances, label=label
+                )
             except ValueError as exc:
                 print(f"sgc evaluate: error: {exc}", file=sys.stderr)
                 return 2
