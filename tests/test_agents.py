@@ -222,6 +222,93 @@ def test_demos_roundtrip_and_cli(tmp_path: Path) -> None:
         load_demos(tmp_path / "missing.npz")
 
 
+PUSHES = {"scale": 0.5, "spin": 0.5, "prob": 0.1, "start": True}
+
+
+def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
+    from baselines.agents.demos import load_demos, record_demos
+    from baselines.agents.pushes import Pushes
+    from sgc_env.commands import demos as demos_command
+
+    plain = record_demos("SGCThreeRods-v0", 2, seed=0)
+    pushed = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(**PUSHES))
+    again = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(**PUSHES))
+    np.testing.assert_array_equal(pushed.observations, again.observations)
+    np.testing.assert_array_equal(pushed.actions, again.actions)
+    first, second = (obs for obs in np.split(plain.observations, 2))
+    np.testing.assert_array_equal(first, second)  # a fixed scene: every episode the same
+    starts = np.flatnonzero(pushed.episode_starts)
+    assert not np.array_equal(pushed.observations[starts[0]], plain.observations[0])
+    assert not np.array_equal(pushed.observations[starts[0]], pushed.observations[starts[1]])
+    never = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(scale=0.5, prob=0.0))
+    np.testing.assert_array_equal(never.observations, plain.observations)
+    path = tmp_path / "pushed.npz"
+    parser = argparse.ArgumentParser()
+    demos_command.add_arguments(parser)
+    args = parser.parse_args(
+        ["--env", "SGCThreeRods-v0", "--episodes", "2", "--seed", "0", "--out", str(path),
+         "--push-scale", "0.5", "--push-spin", "0.5", "--push-prob", "0.1", "--push-start"]
+    )  # fmt: skip
+    assert demos_command.run(args) == 0
+    loaded = load_demos(path)
+    assert loaded.pushes == Pushes(**PUSHES) and plain.pushes == Pushes()
+    np.testing.assert_array_equal(loaded.observations, pushed.observations)
+
+
+def test_default_pushes_draw_nothing() -> None:
+    from baselines.agents.pushes import Pushes, apply_random_push, push_rng
+
+    rng = push_rng(3)
+    state = rng.bit_generator.state
+    obs = np.zeros(4, np.float32)
+    assert apply_random_push(None, obs, Pushes(), rng, tick=0) is obs
+    assert rng.bit_generator.state == state
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [({"scale": -0.1}, "push_scale"), ({"spin": float("nan")}, "push_spin"),
+     ({"scale": 0.1, "prob": 1.5}, "push_prob"), ({"start": True}, "push_start")],
+)  # fmt: skip
+def test_bad_push_arguments_raise(kwargs: dict, name: str, tiny_hp: Path) -> None:
+    from baselines.agents.pushes import Pushes, push_rng
+
+    with pytest.raises(ValueError, match=name):
+        Pushes(**kwargs)
+    with pytest.raises(ValueError, match=name):
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", hyperparams_dir=tiny_hp,
+                          **{f"push_{k}": v for k, v in kwargs.items()}))  # fmt: skip
+    with pytest.raises(ValueError, match="seed"):
+        push_rng(-1)
+    with pytest.raises(ValueError, match="dagger-rounds"):
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", hyperparams_dir=tiny_hp,
+                          push_scale=0.1))  # fmt: skip
+
+
+def test_dagger_pushes_diversify_rollouts_of_a_fixed_scene() -> None:
+    from baselines.agents.bc import dagger
+    from baselines.agents.demos import record_demos
+    from baselines.agents.pushes import Pushes
+    from baselines.agents.train import algorithm_class
+
+    demos = record_demos("SGCIntercept-v0", 1, seed=0)
+
+    def rollout_states(pushes: Pushes | None) -> np.ndarray:
+        model = algorithm_class("ppo")("MlpPolicy", "SGCIntercept-v0", seed=0, device="cpu",
+                                       policy_kwargs={"net_arch": [8]})  # fmt: skip
+        aggregate, _ = dagger(model, demos, 1, 2, seed=0, epochs=1, pushes=pushes)
+        return aggregate.observations[len(demos) :]
+
+    plain = rollout_states(None)
+    first, second = np.split(plain, 2)
+    np.testing.assert_array_equal(first, second)  # a deterministic clone: one path, twice
+    pushed = rollout_states(Pushes(scale=0.5, start=True))
+    np.testing.assert_array_equal(pushed, rollout_states(Pushes(scale=0.5, start=True)))
+    first, second = np.split(pushed[: 2 * (len(pushed) // 2)], 2)
+    assert not np.array_equal(first, second)
+    assert not np.array_equal(pushed[0], plain[0])
+
+
 def test_behaviour_cloning_reduces_imitation_loss(tmp_path: Path, tiny_hp: Path) -> None:
     from baselines.agents.bc import imitation_loss
     from baselines.agents.demos import record_demos
@@ -303,6 +390,32 @@ def test_shipped_checkpoints_are_small_and_score() -> None:
     result = evaluate(str(point), "SGCPoint-v0", 10, 10_000)
     assert result.summary["success_rate"] >= 0.9
     assert result.summary["position_error_max"] <= 0.02
+
+
+#: Shipped model -> (env id, success it must keep on held-out seed 10000), docs/agents.md.
+SHIPPED_SCORES = {
+    "ppo_dagger_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
+    "ppo_dagger_SGCRod-v0.zip": ("SGCRod-v0", 0.0),
+    "ppo_dagger_SGCIntercept-v0.zip": ("SGCIntercept-v0", 1.0),
+    "ppo_dagger_SGCThreeRods-v0.zip": ("SGCThreeRods-v0", 0.0),
+}
+
+
+def test_every_shipped_checkpoint_is_listed() -> None:
+    assert sorted(m.name for m in CHECKPOINTS.glob("*.zip")) == sorted(SHIPPED_SCORES)
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED_SCORES))
+def test_shipped_checkpoint_scores_through_sgc_evaluate(name: str, tmp_path: Path) -> None:
+    from sgc_env import cli
+
+    env_id, success = SHIPPED_SCORES[name]
+    out = tmp_path / "ev"
+    argv = ["evaluate", "--policy", str(CHECKPOINTS / name), "--env", env_id, "--episodes", "1",
+            "--seed", "10000", "--no-plots", "--out", str(out)]  # fmt: skip
+    assert cli.main(argv) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["n_goals"] > 0 and summary["success_rate"] >= success
 
 
 @pytest.mark.slow

@@ -21,6 +21,7 @@ from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.policies import ActorCriticPolicy
 
 from baselines.agents.demos import Demonstrations
+from baselines.agents.pushes import Pushes, apply_random_push, push_rng
 
 __all__ = ["BCResult", "actor_parameters", "behaviour_clone", "dagger", "deterministic_actions"]
 
@@ -134,19 +135,23 @@ def imitation_loss(model: BaseAlgorithm, demos: Demonstrations) -> float:
 
 
 def _label_rollouts(
-    model: BaseAlgorithm, env: gym.Env, expert: Any, seeds: np.ndarray
+    model: BaseAlgorithm, env: gym.Env, expert: Any, seeds: np.ndarray, pushes: Pushes
 ) -> tuple[np.ndarray, np.ndarray]:
-    """States visited by the model's deterministic policy, labelled with the expert's action."""
+    """States visited by the model's deterministic policy, labelled with the expert's action.
+
+    A push replaces the state before it is labelled, so the expert's recovery is learned.
+    """
     states, labels = [], []
     for s in seeds:
         obs, _ = env.reset(seed=int(s))
-        done = False
+        rng, tick, done = push_rng(int(s)), 0, False
         while not done:
+            obs = apply_random_push(env, obs, pushes, rng, tick)
             states.append(obs)
             labels.append(np.clip(expert.predict(obs, deterministic=True)[0], -1.0, 1.0))
             action, _ = model.predict(obs, deterministic=True)
             obs, _, terminated, truncated, _ = env.step(action)
-            done = terminated or truncated
+            done, tick = terminated or truncated, tick + 1
     return np.asarray(states, np.float32), np.asarray(labels, np.float32)
 
 
@@ -160,11 +165,13 @@ def dagger(
     batch_size: int = 256,
     learning_rate: float = 1e-3,
     log_std: float | None = -2.0,
+    pushes: Pushes | None = None,
 ) -> tuple[Demonstrations, BCResult]:
     """``rounds`` of: roll out the clone, relabel with the expert, refit on the aggregate.
 
     Rollout seeds are ``seed + 1_000_000 + r * episodes_per_round + i`` so they never overlap
-    the demonstration or held-out evaluation seeds.
+    the demonstration or held-out evaluation seeds. ``pushes`` knock the clone off its own
+    path during the rollouts (see :mod:`baselines.agents.pushes`); the default pushes nothing.
     """
     from baselines.policies import make_policy
 
@@ -179,7 +186,7 @@ def dagger(
         for r in range(rounds):
             first = seed + 1_000_000 + r * episodes_per_round
             seeds = np.arange(first, first + episodes_per_round)
-            states, labels = _label_rollouts(model, env, expert, seeds)
+            states, labels = _label_rollouts(model, env, expert, seeds, pushes or Pushes())
             demos = demos.extend(states, labels)
             fit = behaviour_clone(
                 model, demos, epochs=epochs, batch_size=batch_size,

@@ -14,7 +14,10 @@ here is flat and documented (docs/agents.md):
 | seeds | (E,) int64 | reset seed of each episode |
 | env_id | () str | registered id |
 | env_kwargs | () str | JSON of the extra ``gym.make`` kwargs |
+| pushes | () str | JSON of the push settings (:class:`~baselines.agents.pushes.Pushes`) |
 | format_version | () int | 1 |
+
+Files written before ``pushes`` existed load with the default (no pushes).
 """
 
 from __future__ import annotations
@@ -26,6 +29,8 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+
+from baselines.agents.pushes import Pushes, apply_random_push, push_rng
 
 __all__ = ["FORMAT_VERSION", "Demonstrations", "load_demos", "record_demos"]
 
@@ -45,6 +50,7 @@ class Demonstrations:
     seeds: np.ndarray
     env_id: str
     env_kwargs: dict[str, Any] = field(default_factory=dict)
+    pushes: Pushes = field(default_factory=Pushes)
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -68,6 +74,7 @@ class Demonstrations:
                 seeds=self.seeds,
                 env_id=np.array(self.env_id),
                 env_kwargs=np.array(json.dumps(self.env_kwargs, sort_keys=True)),
+                pushes=np.array(json.dumps(self.pushes.to_dict(), sort_keys=True)),
                 format_version=np.array(FORMAT_VERSION),
             )
         return path
@@ -85,6 +92,7 @@ class Demonstrations:
             seeds=self.seeds,
             env_id=self.env_id,
             env_kwargs=self.env_kwargs,
+            pushes=self.pushes,
         )
 
 
@@ -109,6 +117,7 @@ def load_demos(path: str | Path) -> Demonstrations:
             seeds=data["seeds"],
             env_id=str(data["env_id"]),
             env_kwargs=json.loads(str(data["env_kwargs"])),
+            pushes=Pushes(**json.loads(str(data["pushes"]))) if "pushes" in data else Pushes(),
         )
 
 
@@ -118,11 +127,14 @@ def record_demos(
     seed: int,
     env_kwargs: dict[str, Any] | None = None,
     policy: Any | None = None,
+    pushes: Pushes | None = None,
 ) -> Demonstrations:
     """Roll out ``policy`` on seeds ``seed .. seed+episodes-1``.
 
     The default policy is the harness's ``expert`` (an :class:`SGCExpert` rebuilt at every
-    episode start, because random scenarios redraw the force limits on reset).
+    episode start, because random scenarios redraw the force limits on reset). With
+    ``pushes``, a pushed step records the observation after the push and the action taken on
+    it, which for the expert is the recovery from the push.
     """
     from baselines.agents.train import check_env_id
 
@@ -130,6 +142,7 @@ def record_demos(
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     env_kwargs = dict(env_kwargs or {})
+    pushes = pushes or Pushes()
     env = gym.make(env_id, **env_kwargs)
     try:
         if not isinstance(env.observation_space, gym.spaces.Box):
@@ -144,8 +157,10 @@ def record_demos(
         seeds = np.arange(seed, seed + episodes, dtype=np.int64)
         for episode_seed in seeds:
             obs, _ = env.reset(seed=int(episode_seed))
+            rng, tick = push_rng(int(episode_seed)), 0
             done, first = False, True
             while not done:
+                obs = apply_random_push(env, obs, pushes, rng, tick)
                 action, _ = policy.predict(obs, deterministic=True)
                 action = np.clip(np.asarray(action, np.float32), -1.0, 1.0)
                 next_obs, reward, terminated, truncated, _ = env.step(action)
@@ -154,6 +169,7 @@ def record_demos(
                 ):
                     cols[key].append(value)
                 obs, first, done = next_obs, False, terminated or truncated
+                tick += 1
     finally:
         env.close()
     return Demonstrations(
@@ -166,4 +182,5 @@ def record_demos(
         seeds=seeds,
         env_id=env_id,
         env_kwargs=env_kwargs,
+        pushes=pushes,
     )

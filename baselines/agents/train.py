@@ -18,6 +18,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from baselines.agents.pushes import Pushes
+
 __all__ = [
     "ALGORITHMS",
     "TrainConfig",
@@ -69,6 +71,10 @@ class TrainConfig:
     critic_warmup: int = 0
     dagger_rounds: int = 0
     dagger_episodes: int = 20
+    push_scale: float = 0.0
+    push_spin: float = 0.0
+    push_prob: float = 0.05
+    push_start: bool = False
     hyperparams_dir: str | Path | None = None
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     device: str = "cpu"
@@ -121,6 +127,14 @@ def _validate(cfg: TrainConfig) -> None:
         raise ValueError(f"timesteps must be >= 0, got {cfg.timesteps}")
     if cfg.eval_freq < 0 or cfg.checkpoint_freq < 0 or cfg.critic_warmup < 0:
         raise ValueError("eval_freq, checkpoint_freq and critic_warmup must be >= 0")
+    if _pushes(cfg).active and not (cfg.init == "bc" and cfg.dagger_rounds > 0):
+        raise ValueError("push_scale/push_spin act on DAgger rollouts: need --init bc and "
+                         "--dagger-rounds >= 1")  # fmt: skip
+
+
+def _pushes(cfg: TrainConfig) -> Pushes:
+    """The DAgger rollouts' pushes (validated by :class:`Pushes`)."""
+    return Pushes(cfg.push_scale, cfg.push_spin, cfg.push_prob, cfg.push_start)
 
 
 def _jsonable(value: Any) -> Any:
@@ -265,9 +279,10 @@ def _clone(model: Any, cfg: TrainConfig) -> dict[str, Any]:
     if cfg.dagger_rounds:
         aggregate, rounds = dagger(
             model, demos, cfg.dagger_rounds, cfg.dagger_episodes, cfg.seed,
-            epochs=max(cfg.bc_epochs // 3, 1), log_std=cfg.bc_log_std,
+            epochs=max(cfg.bc_epochs // 3, 1), log_std=cfg.bc_log_std, pushes=_pushes(cfg),
         )  # fmt: skip
         info.update(dagger_rounds=rounds.rounds, samples_after_dagger=len(aggregate))
+    info["demo_pushes"] = demos.pushes.to_dict()
     return info
 
 

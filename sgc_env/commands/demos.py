@@ -4,6 +4,37 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import Any
+
+
+def add_push_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--push-*``: random impulses for state diversity (shared with ``sgc train``)."""
+    parser.add_argument(
+        "--push-scale", type=float, default=0.0,
+        help="per-axis std (m/s) of a push's velocity change (0: no pushes)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--push-spin", type=float, default=0.0,
+        help="per-axis std (rad/s) of a push's angular velocity change (bodies with torques)",
+    )  # fmt: skip
+    parser.add_argument("--push-prob", type=float, default=0.05, help="chance of a push per tick")
+    parser.add_argument("--push-start", action="store_true", help="push every episode at tick 0")
+
+
+def push_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``--push-*`` values under the keyword names of ``Pushes`` / ``TrainConfig``."""
+    return {
+        "scale": args.push_scale, "spin": args.push_spin,
+        "prob": args.push_prob, "start": args.push_start,
+    }  # fmt: skip
+
+
+def parse_env_kwargs(text: str | None) -> dict[str, Any]:
+    """``--env-kwargs`` as a dict (a JSON object or nothing)."""
+    env_kwargs = json.loads(text) if text else {}
+    if not isinstance(env_kwargs, dict):
+        raise ValueError(f"--env-kwargs must be a JSON object, got {text!r}")
+    return env_kwargs
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -12,15 +43,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="episodes use seed, seed+1, ...")
     parser.add_argument("--out", required=True, help="output .npz")
     parser.add_argument("--env-kwargs", default=None, help="JSON dict passed to gym.make")
+    add_push_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.demos import record_demos
+    from baselines.agents.pushes import Pushes
 
-    env_kwargs = json.loads(args.env_kwargs) if args.env_kwargs else {}
-    if not isinstance(env_kwargs, dict):
-        raise ValueError(f"--env-kwargs must be a JSON object, got {args.env_kwargs!r}")
-    demos = record_demos(args.env, args.episodes, args.seed, env_kwargs)
+    env_kwargs = parse_env_kwargs(args.env_kwargs)
+    pushes = Pushes(**push_options(args))
+    demos = record_demos(args.env, args.episodes, args.seed, env_kwargs, pushes=pushes)
     path = demos.save(args.out)
     print(f"{demos.n_episodes} episodes, {len(demos)} steps of {args.env} -> {path}")
     return 0

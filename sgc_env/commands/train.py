@@ -7,6 +7,8 @@ import json
 import shlex
 import sys
 
+from sgc_env.commands.demos import add_push_arguments, parse_env_kwargs, push_options
+
 ALGOS = ("ppo", "sac", "td3", "her")
 
 
@@ -41,6 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     parser.add_argument("--dagger-rounds", type=int, default=0, help="DAgger rounds after cloning")
     parser.add_argument("--dagger-episodes", type=int, default=20, help="rollouts per DAgger round")
+    add_push_arguments(parser)
     parser.add_argument(
         "--hyperparams", default=None, help="folder of <algo>.yml (default: hyperparams/)"
     )
@@ -52,9 +55,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.train import TrainConfig, train
 
-    env_kwargs = json.loads(args.env_kwargs) if args.env_kwargs else {}
-    if not isinstance(env_kwargs, dict):
-        raise ValueError(f"--env-kwargs must be a JSON object, got {args.env_kwargs!r}")
+    env_kwargs = parse_env_kwargs(args.env_kwargs)
+    pushes = {f"push_{key}": value for key, value in push_options(args).items()}
     cfg = TrainConfig(
         algo=args.algo, env_id=args.env, seed=args.seed, timesteps=args.timesteps,
         out=args.out, progress=args.progress, eval_freq=args.eval_freq,
@@ -64,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
         hyperparams_dir=args.hyperparams, env_kwargs=env_kwargs, device=args.device,
         checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
-        command=shlex.join(["sgc", *sys.argv[1:]]),
+        command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip
     result = train(cfg)
     print(
