@@ -114,7 +114,7 @@ def _closest_orientation(
         k = int(inside[np.argmin(angle[inside])])
         if angle[k] < math.pi / 2:
             near = slice(max(k - 1, int(inside[0])), min(k + 2, int(inside[-1]) + 1))
-            offsets = traj.orientation_offset(target)[near]
+            offsets = traj.orientation_offset(target, near)
             return sg.closest_approach(traj.times[near], offsets, lo, hi)
     return sg.closest_approach(traj.times, angle, lo, hi)
 

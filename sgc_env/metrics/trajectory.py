@@ -190,11 +190,14 @@ class BodyTrajectory:
         goal = Rotation.from_quat(np.asarray(target, dtype=float))
         return (self.rotations() * goal.inv()).magnitude()
 
-    def orientation_offset(self, target: Sequence[float]) -> FloatArray:
-        """Rotation vectors (n, 3) of each sampled orientation relative to `target` (xyzw).
+    def orientation_offset(
+        self, target: Sequence[float], samples: slice = slice(None)
+    ) -> FloatArray:
+        """Rotation vectors of the sampled orientations (``samples`` of them) relative to
+        `target` (xyzw).
 
         Principal vectors: continuous wherever the angle stays below pi, which is where a
         closest approach is refined.
         """
         goal = Rotation.from_quat(np.asarray(target, dtype=float))
-        return (self.rotations() * goal.inv()).as_rotvec()
+        return (Rotation.from_quat(self.body_orientation[samples]) * goal.inv()).as_rotvec()
