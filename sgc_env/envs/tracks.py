@@ -18,7 +18,6 @@ from baselines.sgc.orientation import MAX_COURSE_ROTATION, course_pieces
 from sgc_env.scenario import Body, Scenario
 
 __all__ = [
-    "MAX_COURSE_ROTATION",
     "BodyTracks",
     "Track",
     "compile_tracks",
