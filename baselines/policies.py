@@ -128,22 +128,25 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 
     Model files sharing a stem (``a/final_model.zip``, ``b/final_model.zip``) are told apart
     by as many parent folders as it takes (``a-final_model``), so their outputs do not
-    overwrite each other. A spec given twice is an error.
+    overwrite each other. A spec given twice (also as two spellings of one file) is an error.
     """
-    seen = [s for s in specs if list(specs).count(s) > 1]
-    if seen:
-        raise ValueError(f"policy: {seen[0]!r} is given more than once")
+    files = [None if s in BUILTIN_POLICIES else Path(s).resolve() for s in specs]
+    identities = [str(f) if f is not None else s for s, f in zip(specs, files, strict=True)]
+    for spec, identity in zip(specs, identities, strict=True):
+        if identities.count(identity) > 1:
+            raise ValueError(f"policy: {spec!r} is given more than once")
     labels = [policy_label(s) for s in specs]
-    depth = 1
-    while len(set(labels)) < len(labels):
+    folders = [() if f is None else f.parent.relative_to(f.anchor).parts for f in files]
+    for depth in range(1, max(map(len, folders), default=0) + 1):
         clashing = {label for label in labels if labels.count(label) > 1}
+        if not clashing:
+            return labels
         labels = [
-            "-".join([*Path(spec).resolve().parent.parts[-depth:], Path(spec).stem])
-            if label in clashing and spec not in BUILTIN_POLICIES
-            else label
-            for spec, label in zip(specs, labels, strict=True)
+            "-".join([*parts[-depth:], f.stem]) if f is not None and label in clashing else label
+            for f, parts, label in zip(files, folders, labels, strict=True)
         ]
-        depth += 1
+    if len(set(labels)) < len(labels):
+        raise ValueError(f"policy: cannot give {list(specs)} distinct labels; rename the files")
     return labels
 
 

@@ -155,6 +155,10 @@ def test_policy_labels_are_distinct():
     assert policy_labels(["random", "runs/model.zip"]) == ["random", "model"]
     with pytest.raises(ValueError, match="'expert' is given more than once"):
         policy_labels(["expert", "random", "expert"])
+    with pytest.raises(ValueError, match="given more than once"):
+        policy_labels(["a/m.zip", "./a/m.zip"])  # one file, two spellings
+    with pytest.raises(ValueError, match="distinct labels"):
+        policy_labels(["/x/a-m.zip", "/x/a/m.zip", "/y/a/m.zip"])
 
 
 @pytest.mark.parametrize(
