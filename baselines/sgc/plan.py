@@ -180,14 +180,14 @@ class BodyPlan:
     """Result of :func:`plan_body`. ``sample(t)`` for ``t >= 0``; ``courses`` diagnostics."""
 
     def __init__(
-        self, initial, orient_goals, orient_track, pos_goals, pos_track, courses, goal_ends=()
+        self, initial, orient_goals, goal_rotations, orient_track, pos_goals, pos_track, courses
     ):
         self._x0 = initial[0]
         self._r0 = initial[1]
         self._v0 = initial[2]
         self._w0 = initial[3]
         self._orient_goals = orient_goals  # Rotation at the end of each orientation course
-        self._goal_ends = list(goal_ends)  # courses that end on a goal (not a somersault piece)
+        self._goal_rotations = goal_rotations  # one per orientation goal (not per piece)
         self._orient = orient_track
         self._pos_goals = pos_goals  # list of (nail, point)
         self._pos = pos_track
@@ -195,7 +195,7 @@ class BodyPlan:
 
     def goal_orientations(self) -> list[np.ndarray]:
         """Resolved goal orientations (quaternions xyzw), relative goals composed."""
-        return [self._orient_goals[k].as_quat() for k in self._goal_ends]
+        return [r.as_quat() for r in self._goal_rotations]
 
     def _orientation(self, t: float) -> tuple[Rotation, np.ndarray, np.ndarray]:
         if self._orient is None:
@@ -252,13 +252,14 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
 
 
 def _orientation_courses(r0, goals, times):
-    """(goal rotation, phi at the course start, end time, goal index) per course.
+    """(goal rotation, phi at the course start, end time, goal index) per course, and the
+    rotation each goal reaches.
 
     A relative rotation longer than ``MAX_COURSE_ROTATION`` becomes equal sub-rotations about
     its axis, evenly timed, as in the env: a course starting on ``|phi| = 2 pi`` could not
     carry the angular velocity across its axis.
     """
-    out = []
+    out, reached = [], []
     prev, t_prev = r0, 0.0
     for i, g in enumerate(goals):
         where = f"orientation goal {i}"
@@ -275,12 +276,13 @@ def _orientation_courses(r0, goals, times):
                 prev = Rotation.from_rotvec(rel / m) * prev
                 end = times[i] if j == m else t_prev + (times[i] - t_prev) * j / m
                 out.append((prev, -rel / m, end, i))
+        reached.append(prev)
         t_prev = times[i]
-    return out
+    return out, reached
 
 
 def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
-    pieces = _orientation_courses(r0, goals, times)
+    pieces, reached = _orientation_courses(r0, goals, times)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
     courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
@@ -302,10 +304,7 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
         t_prev = ends[i]
     end_state = courses[-1].state(courses[-1].duration)[1]
     track = _Track([0.0, *ends[:-1]], ends, courses, end_state)
-    goal_ends = [
-        k for k, piece in enumerate(pieces) if k == len(pieces) - 1 or pieces[k + 1][3] != piece[3]
-    ]
-    return [goal for goal, _, _, _ in pieces], goal_ends, track
+    return [goal for goal, _, _, _ in pieces], reached, track
 
 
 def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
@@ -398,15 +397,15 @@ def plan_body(
     p_times = _check_times([g.time for g in position_goals], "position")
     o_times = _check_times([g.time for g in orientation_goals], "orientation")
     diags: list[CourseDiagnostics] = []
-    rots, goal_ends, o_track = [], [], None
+    rots, goal_rots, o_track = [], [], None
     if orientation_goals:
-        rots, goal_ends, o_track = _plan_orientation(
+        rots, goal_rots, o_track = _plan_orientation(
             r0, w0, orientation_goals, o_times, end_w, opts, diags
         )
-    plan = BodyPlan((x0, r0, v0, w0), rots, o_track, [], None, diags, goal_ends)
+    plan = BodyPlan((x0, r0, v0, w0), rots, goal_rots, o_track, [], None, diags)
     if position_goals:
         resolved, p_track = _plan_position(
             x0, v0, plan._orientation, position_goals, p_times, end_v, opts, diags
         )
-        plan = BodyPlan((x0, r0, v0, w0), rots, o_track, resolved, p_track, diags, goal_ends)
+        plan = BodyPlan((x0, r0, v0, w0), rots, goal_rots, o_track, resolved, p_track, diags)
     return plan
