@@ -14,12 +14,12 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from baselines.env_model import BodyModel, EnvModel
-from baselines.sgc import quaternion as quat
 from baselines.tracking import (
     held_acceleration_for_position,
     simulate_rotation,
     torque_for_orientation,
 )
+from sgc_env.paper import quaternion as quat
 
 __all__ = ["BodyObservation", "body_wrench", "read_body", "wrench_for_targets"]
 

@@ -28,8 +28,8 @@ from baselines.actuation import BodyObservation, read_body, wrench_for_targets
 from baselines.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.env_model import EnvModel
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
-from baselines.sgc.orientation import left_jacobian_inverse
 from sgc_env.metrics import goals_from_scenario
+from sgc_env.paper.orientation import left_jacobian_inverse
 from sgc_env.scenario import Scenario
 
 __all__ = [

@@ -20,10 +20,10 @@ import numpy as np
 
 from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
-from baselines.sgc import quaternion as quat
-from baselines.sgc.frames import course_end_velocity, next_deviation
-from baselines.sgc.orientation import left_jacobian_inverse_apply
 from sgc_env.observation import ObservationLayout
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.frames import course_end_velocity, next_deviation
+from sgc_env.paper.orientation import left_jacobian_inverse_apply
 
 __all__ = ["SGCExpert"]
 

@@ -22,7 +22,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from baselines.sgc import quaternion as quat
+from sgc_env.paper import quaternion as quat
 
 __all__ = [
     "held_acceleration_for_position",

@@ -19,8 +19,8 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from baselines.sgc.course import CourseProfile, solve_batch
-from baselines.sgc.frames import course_end_velocity, solve_course_in_frame
+from sgc_env.paper.course import CourseProfile, solve_batch
+from sgc_env.paper.frames import course_end_velocity, solve_course_in_frame
 
 
 def _s_c(z: float) -> tuple[float, float]:

@@ -23,7 +23,7 @@ __all__ = ["PRESETS", "RandomScenarioConfig", "planner_demand", "random_scenario
 
 # Conservative need of an SGC course: acceleration _ACCEL_FACTOR * (average speed of the course
 # + of the one before) / duration, angular acceleration _ACCEL_FACTOR * angle / duration^2.
-# Against baselines.sgc.plan on 120 random draws the plan's peak stayed below 0.93 of the bound
+# Against sgc_env.paper.plan on 120 random draws the plan's peak stayed below 0.93 of the bound
 # with factor 24; 30 adds margin. tests/test_scenario.py re-checks it with the planner.
 _ACCEL_FACTOR = 30.0
 
@@ -172,13 +172,13 @@ def random_scenario(
 
 
 def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, float]]:
-    """Peak |force| and |torque| per body along the analytic SGC plan (``baselines.sgc.plan``).
+    """Peak |force| and |torque| per body along the analytic SGC plan (``sgc_env.paper.plan``).
 
     Force = m (a - g); torque bounded by I_max |alpha| + I_max |omega|^2 (gyroscopic term).
     Costly (milliseconds), so the env does not call it on every reset; tests use it to show
     that the limits from the geometric bound cover what the plan needs.
     """
-    from baselines.sgc.plan import BodyState, OrientationGoal, PositionGoal, plan_body
+    from sgc_env.paper.plan import BodyState, OrientationGoal, PositionGoal, plan_body
 
     g = np.asarray(scenario.gravity, float)
     out = []

@@ -2,7 +2,7 @@
 
 A scenario is plain frozen data. ``resolve_scenario`` turns a user scenario into the form the
 environment runs: every goal gets a time on the control grid (non-critical times from the
-routing weights of ``baselines.sgc.routing``), nails bound to props are computed from the
+routing weights of ``sgc_env.paper.routing``), nails bound to props are computed from the
 prop's scripted path, and every field is checked with a message that names the field path.
 """
 
@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from baselines.sgc import quaternion as quat
-from baselines.sgc.routing import resolve_goal_times
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.routing import resolve_goal_times
 
 __all__ = [
     "SHAPES",

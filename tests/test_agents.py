@@ -192,7 +192,7 @@ def test_same_seed_same_parameters_and_scorecard(tiny_hp: Path) -> None:
 
 def test_demos_roundtrip_and_cli(tmp_path: Path) -> None:
     from baselines.agents.demos import load_demos, record_demos
-    from sgc_env.commands import demos as demos_command
+    from baselines.cli.commands import demos as demos_command
 
     demos = record_demos("SGCPoint-v0", 2, seed=5)
     assert demos.n_episodes == 2 and list(demos.seeds) == [5, 6]
@@ -228,7 +228,7 @@ PUSHES = {"scale": 0.5, "spin": 0.5, "prob": 0.1, "start": True}
 def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
     from baselines.agents.demos import load_demos, record_demos
     from baselines.agents.pushes import Pushes
-    from sgc_env.commands import demos as demos_command
+    from baselines.cli.commands import demos as demos_command
 
     plain = record_demos("SGCThreeRods-v0", 2, seed=0)
     pushed = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(**PUSHES))
@@ -361,7 +361,7 @@ def test_behaviour_cloning_into_off_policy_actor(algo: str, tiny_hp: Path) -> No
 
 
 def test_train_command_runs(tmp_path: Path, tiny_hp: Path) -> None:
-    from sgc_env.commands import train as train_command
+    from baselines.cli.commands import train as train_command
 
     parser = argparse.ArgumentParser()
     train_command.add_arguments(parser)
@@ -407,7 +407,7 @@ def test_every_shipped_checkpoint_is_listed() -> None:
 
 @pytest.mark.parametrize("name", sorted(SHIPPED_SCORES))
 def test_shipped_checkpoint_scores_through_sgc_evaluate(name: str, tmp_path: Path) -> None:
-    from sgc_env import cli
+    from baselines.cli import main as cli
 
     env_id, success = SHIPPED_SCORES[name]
     out = tmp_path / "ev"

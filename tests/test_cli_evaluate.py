@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from baselines.cli import main as cli
 from baselines.evaluation import GOAL_COLUMNS
-from sgc_env import cli
 
 SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
 
@@ -23,7 +23,7 @@ def _importable_commands(monkeypatch):
     present = {
         name: text
         for name, text in cli.COMMANDS.items()
-        if importlib.util.find_spec(f"sgc_env.commands.{name.replace('-', '_')}") is not None
+        if importlib.util.find_spec(f"baselines.cli.commands.{name.replace('-', '_')}") is not None
     }
     monkeypatch.setattr(cli, "COMMANDS", present)
 

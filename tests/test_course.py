@@ -1,4 +1,4 @@
-"""Properties of one SGC course component (baselines.sgc.course)."""
+"""Properties of one SGC course component (sgc_env.paper.course)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from baselines.sgc import course as course_mod
-from baselines.sgc.course import (
+from sgc_env.paper import course as course_mod
+from sgc_env.paper.course import (
     CourseProfile,
     HermiteProfile,
     HoldProfile,

@@ -1,4 +1,4 @@
-"""Normalized frames, the k rules and mid-course re-solves (baselines.sgc.frames)."""
+"""Normalized frames, the k rules and mid-course re-solves (sgc_env.paper.frames)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from baselines.sgc.frames import (
+from sgc_env.paper.frames import (
     C_HIGH,
     C_LOW,
     K_MIN,

@@ -1,4 +1,4 @@
-"""Rotation-vector deviations, Jacobians and unwrapping (baselines.sgc.orientation)."""
+"""Rotation-vector deviations, Jacobians and unwrapping (sgc_env.paper.orientation)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from baselines.sgc.orientation import (
+from sgc_env.paper.orientation import (
     angular_acceleration,
     angular_velocity,
     left_jacobian,

@@ -1,4 +1,4 @@
-"""Whole-body plans (baselines.sgc.plan): exactness, continuity, defined edge cases."""
+"""Whole-body plans (sgc_env.paper.plan): exactness, continuity, defined edge cases."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from baselines.sgc.frames import C_LOW, normalized_frame
-from baselines.sgc.plan import (
+from sgc_env.paper.frames import C_LOW, normalized_frame
+from sgc_env.paper.plan import (
     BodyState,
     OrientationGoal,
     PlanOptions,

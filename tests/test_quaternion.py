@@ -1,4 +1,4 @@
-"""Plain-float quaternion helpers against scipy (baselines.sgc.quaternion)."""
+"""Plain-float quaternion helpers against scipy (sgc_env.paper.quaternion)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from baselines.sgc import quaternion as quat
+from sgc_env.paper import quaternion as quat
 
 
 @pytest.mark.parametrize("scale", [0.0, 1e-13, 1e-9, 1e-3, 1.0, 3.0, 7.0])

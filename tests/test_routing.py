@@ -1,4 +1,4 @@
-"""Routing-time allocation (baselines.sgc.routing)."""
+"""Routing-time allocation (sgc_env.paper.routing)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from baselines.sgc.routing import allocate_course_durations, resolve_goal_times
+from sgc_env.paper.routing import allocate_course_durations, resolve_goal_times
 
 pos = st.floats(1e-3, 1e3)
 

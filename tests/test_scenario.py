@@ -207,7 +207,7 @@ def test_unknown_builtin_lists_choices():
 
 @pytest.mark.parametrize("preset", ["point", "rod"])
 def test_random_limits_cover_the_analytic_plan(preset):
-    pytest.importorskip("baselines.sgc.plan")
+    pytest.importorskip("sgc_env.paper.plan")
     from sgc_env.random_scenarios import planner_demand
 
     rng = np.random.default_rng(123)

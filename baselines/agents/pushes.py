@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from baselines.sgc.quaternion import to_matrix
+from sgc_env.paper.quaternion import to_matrix
 
 __all__ = ["PUSH_STREAM", "Pushes", "apply_random_push", "push_rng"]
 

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from baselines.sgc import quaternion
-from baselines.sgc.orientation import MAX_COURSE_ROTATION, course_pieces
+from sgc_env.paper import quaternion
+from sgc_env.paper.orientation import MAX_COURSE_ROTATION, course_pieces
 from sgc_env.scenario import Body, Scenario
 
 __all__ = [

@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.sgc.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_velocity
-from baselines.sgc.frames import solve_course_in_frame as _solve_in_frame
-from baselines.sgc.orientation import (
+from sgc_env.paper.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_velocity
+from sgc_env.paper.frames import solve_course_in_frame as _solve_in_frame
+from sgc_env.paper.orientation import (
     angular_acceleration,
     course_pieces,
     left_jacobian,
@@ -103,7 +103,7 @@ class OrientationGoal:
 
 @dataclass(frozen=True)
 class PlanOptions:
-    """The k-rule constants of ``baselines.sgc.frames`` (defaults documented there)."""
+    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there)."""
 
     c_low: float = C_LOW
     c_high: float = C_HIGH

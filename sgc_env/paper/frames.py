@@ -32,7 +32,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from baselines.sgc.course import CourseProfile, HermiteProfile, HoldProfile
+from sgc_env.paper.course import CourseProfile, HermiteProfile, HoldProfile
 
 __all__ = [
     "C_HIGH",

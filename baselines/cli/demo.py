@@ -188,7 +188,7 @@ def _per_rod(record: Any, rows: Sequence[dict[str, Any]], scenario: Any) -> list
 
 
 def _plots(record: Any, out: Path) -> dict[str, Path]:
-    from sgc_env.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
+    from baselines.cli.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
 
     traj = trajectory_arrays(record.infos, record.initial_info)
     return {

@@ -136,7 +136,7 @@ def _write_pair(result: Any, out: Path, plots: bool) -> None:
     write_summary_json(result.summary, out / "summary.json")
     if not plots:
         return
-    from sgc_env.plots import plot_goal_errors, plot_speed_profile, trajectory_arrays
+    from baselines.cli.plots import plot_goal_errors, plot_speed_profile, trajectory_arrays
 
     title = f"{result.policy} on {result.env_id}"
     plot_goal_errors(result.rows, out / "goal_errors.png", title=title)

@@ -1,4 +1,4 @@
-"""The ``sgc`` console command: one subcommand per module in :mod:`sgc_env.commands`.
+"""The ``sgc`` console command: one subcommand per module in :mod:`baselines.cli.commands`.
 
 Each command module exposes ``add_arguments(parser)`` and ``run(args) -> int``; heavy imports
 (PyBullet, torch) happen inside ``run`` so that ``sgc --help`` stays fast.
@@ -27,7 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_text in COMMANDS.items():
-        module = importlib.import_module(f"sgc_env.commands.{name.replace('-', '_')}")
+        module = importlib.import_module(f"baselines.cli.commands.{name.replace('-', '_')}")
         command_parser = sub.add_parser(name, help=help_text, description=help_text)
         module.add_arguments(command_parser)
         command_parser.set_defaults(_module=module)

@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
     from rich.table import Table
 
-    from sgc_env.demo import DemoOptions, run_demo
+    from baselines.cli.demo import DemoOptions, run_demo
 
     console = Console()
     options = DemoOptions(

@@ -7,7 +7,7 @@ import json
 import shlex
 import sys
 
-from sgc_env.commands.demos import add_push_arguments, parse_env_kwargs, push_options
+from baselines.cli.commands.demos import add_push_arguments, parse_env_kwargs, push_options
 
 ALGOS = ("ppo", "sac", "td3", "her")
 
