@@ -18,37 +18,18 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
+from sgc_env import check_env_id
 
 __all__ = [
     "ALGORITHMS",
     "TrainConfig",
     "TrainResult",
     "algorithm_class",
-    "check_env_id",
     "load_model",
     "train",
 ]
-
-ALGORITHMS: tuple[str, ...] = ("ppo", "sac", "td3", "her")
-
-
-def algorithm_class(algo: str):
-    """SB3 class for ``algo`` (HER is SAC with a ``HerReplayBuffer``)."""
-    from stable_baselines3 import PPO, SAC, TD3
-
-    classes = {"ppo": PPO, "sac": SAC, "td3": TD3, "her": SAC}
-    if algo not in classes:
-        raise ValueError(f"algo: unknown algorithm {algo!r}; choose from {ALGORITHMS}")
-    return classes[algo]
-
-
-def check_env_id(env_id: str) -> None:
-    """Raise a ValueError naming the known ids when ``env_id`` is not registered."""
-    import sgc_env
-
-    if env_id not in gym.registry:
-        raise ValueError(f"env: unknown env id {env_id!r}; registered: {sgc_env.ENV_IDS}")
 
 
 @dataclass
@@ -115,7 +96,7 @@ def _action_noise(hp, action_space: gym.spaces.Box):
 
 def _validate(cfg: TrainConfig) -> None:
     algorithm_class(cfg.algo)
-    check_env_id(cfg.env_id)
+    check_env_id(cfg.env_id, "env")
     if cfg.init not in ("none", "bc"):
         raise ValueError(f"init: expected 'none' or 'bc', got {cfg.init!r}")
     if cfg.init == "bc":
