@@ -3,7 +3,7 @@
 Everything that decides a run is written next to its model in ``config.json`` (resolved
 hyperparameters, seed, command), and every random source is seeded from ``seed``: SB3's
 ``set_random_seed``, the training envs (``seed + rank``), the model and the evaluation seeds
-(held out: :data:`~baselines.agents.callbacks.EVAL_SEED` onwards). On CPU the same seed and
+(held out: :data:`~sgc_env.defaults.EVAL_SEED` onwards). On CPU the same seed and
 command give the same parameters and the same scorecard.
 """
 
@@ -21,6 +21,7 @@ import numpy as np
 from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
 from sgc_env import check_env_id
+from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
     "ALGORITHMS",
@@ -44,7 +45,7 @@ class TrainConfig:
     progress: bool = False
     eval_freq: int = 0
     eval_episodes: int = 10
-    eval_seed: int = 10_000
+    eval_seed: int = EVAL_SEED
     init: str = "none"
     demos: str | Path | None = None
     bc_epochs: int = 30
