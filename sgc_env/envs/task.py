@@ -122,11 +122,11 @@ class GoalTask:
     """Goal tracking of every body of one resolved scenario (see the module docstring).
 
     Per step the env calls :meth:`measure` with the bodies' states, then :meth:`advance` on a
-    tick where a goal falls (:attr:`next_event`), then :meth:`reward`. After :meth:`measure`
-    the public lists hold, per body: :attr:`points` (world position of the tracked point),
-    :attr:`deviations` (D and D', zeros without a position track), :attr:`phi` (unwrapped
-    rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`, and
-    :attr:`scaled_deviation`, ``sum_b |D_b| / L_b + |phi_b| / A_b`` with the current course's
+    tick where a goal falls (:attr:`next_event`), then :attr:`reward_function`. After
+    :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
+    tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
+    (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`;
+    and :attr:`scaled_deviation`, ``sum_b |D_b| / L_b + |phi_b| / A_b`` with the current course's
     scales (:attr:`position_scale` = 1 / L, :attr:`orientation_scale` = 1 / A).
     """
 
@@ -345,9 +345,6 @@ class GoalTask:
                 any_changed = True
         self.next_event = self._first_pending_tick(tick)
         return events, any_changed
-
-    def reward(self, action: Sequence[float], events: Sequence[GoalEvent]) -> float:
-        return self.reward_function(self, action, events)
 
     # ---------------------------------------------------------------- goal-conditioned view
 
