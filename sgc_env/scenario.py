@@ -79,7 +79,7 @@ LIMITS: dict[str, tuple[float, float, str, str]] = {
              "float32 time in the observation still resolves 1 ms; the episode cap is "
              f"{MAX_EPISODE_STEPS} ticks"),
     "margin": (0.0, 1e3, "s", "the episode runs this long after the last goal"),
-    "relative_rotation": (0.0, 64 * math.pi, "rad",
+    "relative_rotation": (0.0, 64 * math.pi, "rad",  # = paper.orientation.MAX_RELATIVE_ROTATION
                           "32 turns (96 planner courses of 2 pi / 3) per goal"),
     "gravity": (0.0, 1e3, "m/s^2", "about 100 g; forces to hold a body must stay reportable"),
     "weight": (1e-9, 1e9, "", "routing divides by weights; their ratios set goal times"),

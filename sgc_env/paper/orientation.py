@@ -21,6 +21,7 @@ from scipy.spatial.transform import Rotation
 
 __all__ = [
     "MAX_COURSE_ROTATION",
+    "MAX_RELATIVE_ROTATION",
     "angular_acceleration",
     "course_pieces",
     "angular_velocity",
@@ -45,10 +46,18 @@ one axis. Planner and env therefore split a somersault into equal sub-rotations 
 same axis, timed evenly, each one a course of its own.
 """
 
+MAX_RELATIVE_ROTATION = 64.0 * math.pi
+"""Longest relative rotation of one goal (32 turns, 96 courses): bounds the planner's work."""
+
 
 def course_pieces(rotation_vector) -> int:
     """How many equal courses a relative rotation is split into (see MAX_COURSE_ROTATION)."""
     angle = float(np.linalg.norm(np.asarray(rotation_vector, dtype=float)))
+    if not angle <= MAX_RELATIVE_ROTATION:
+        raise ValueError(
+            f"relative rotation of {angle:.6g} rad is longer than {MAX_RELATIVE_ROTATION:.6g} "
+            "rad (32 turns), the most one goal may ask"
+        )
     return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
 
 

@@ -271,7 +271,10 @@ def _orientation_courses(r0, goals, times):
             prev = goal
         else:
             rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
-            m = course_pieces(rel)
+            try:
+                m = course_pieces(rel)
+            except ValueError as exc:
+                raise ValueError(f"{where}: {exc}") from None
             for j in range(1, m + 1):
                 prev = Rotation.from_rotvec(rel / m) * prev
                 end = times[i] if j == m else t_prev + (times[i] - t_prev) * j / m
