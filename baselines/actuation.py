@@ -48,15 +48,6 @@ class BodyObservation:
     def track(self, name: str) -> dict[str, np.ndarray]:
         return self.position if name == "position" else self.orientation_track
 
-    def has_goal_ahead(self, name: str, period: float) -> bool:
-        """True while a goal of track ``name`` lies at least one tick ahead.
-
-        Half a period of slack: on a goal's own tick the time left is zero up to rounding of
-        the tick times, and that goal must count as reached, not as still ahead.
-        """
-        t = self.track(name)
-        return bool(t["flags"][0] > 0.5 and t["time_left"][0] > 0.5 * period)
-
 
 def read_body(model: EnvModel, observation: np.ndarray, body: int) -> BodyObservation:
     """Extract body ``body``'s fields, adding each ``<field>_residual`` where the layout has one."""

@@ -282,13 +282,6 @@ def summarize(
     }
 
 
-def _check_env_id(env_id: str) -> None:
-    if not isinstance(env_id, str) or env_id not in gym.registry:
-        raise ValueError(
-            f"env_id: unknown environment {env_id!r}; SGC ids: {list(sgc_env.ENV_IDS)}"
-        )
-
-
 def _resolve_policy(
     policy: PolicyLike | str | Callable[[gym.Env], PolicyLike], env: gym.Env, seed: int
 ) -> tuple[PolicyLike, str]:
@@ -324,7 +317,7 @@ def evaluate(
     :class:`~baselines.MinimumJerkController`). ``keep_infos``: how many leading episodes
     keep their infos for plots. The env is created here and closed at the end.
     """
-    _check_env_id(env_id)
+    sgc_env.check_env_id(env_id)
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer):

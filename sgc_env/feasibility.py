@@ -56,8 +56,9 @@ def inertia_bound(shape: str, size: tuple[float, ...], mass: float) -> float:
     return float(inertia_diagonal(shape, size, mass).max())
 
 
-def _plan(b: Body):
-    from sgc_env.paper.plan import BodyState, OrientationGoal, PositionGoal, plan_body
+def _plan(b: Body, control_frequency: int):
+    """The body's plan, with somersault sub-courses timed on the env's ticks."""
+    from sgc_env.paper.plan import BodyState, OrientationGoal, PlanOptions, PositionGoal, plan_body
 
     def vec(v):
         return None if v is None else np.asarray(v, float)
@@ -74,6 +75,7 @@ def _plan(b: Body):
         ],
         end_velocity=vec(b.end_velocity),
         end_angular_velocity=vec(b.end_angular_velocity),
+        options=PlanOptions(control_frequency=control_frequency),
     )
 
 
@@ -102,7 +104,7 @@ def body_demands(scenario: Scenario, periods: int | None = None) -> list[BodyDem
     dt = 1.0 / freq
     out = []
     for b in scenario.bodies:
-        plan = _plan(b)
+        plan = _plan(b, freq)
         inertia = np.diag(inertia_diagonal(b.shape, b.size, b.mass))
         goal_ticks = [round(float(gl.time) * freq) for gl in b.goals]  # type: ignore[arg-type]
         cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}

@@ -391,3 +391,11 @@ def test_goals_of_every_body_are_reported_when_another_body_is_done():
             (e["body"], e["goal"], round(e["time"] * 60)) for e in info.get("goal_reached", [])
         ]
     assert events == [(1, 0, 15), (0, 0, 30), (1, 1, 60)]
+
+
+def test_one_env_id_check_names_the_field_and_the_ids():
+    assert sgc_env.check_env_id("SGCPoint-v0") == "SGCPoint-v0"
+    with pytest.raises(ValueError, match=r"^env: unknown environment 'Nope-v0'; SGC ids: \['SGCP"):
+        sgc_env.check_env_id("Nope-v0", "env")
+    with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
+        sgc_env.check_env_id(3)

@@ -27,6 +27,7 @@ __all__ = [
     "existing_dir",
     "existing_file",
     "fraction",
+    "known_env_id",
     "nonneg_float",
     "nonneg_int",
     "out_dir",
@@ -144,6 +145,16 @@ def existing_dir(text: str) -> Path:
     if not path.is_dir():
         raise argparse.ArgumentTypeError(f"no such folder: {path}")
     return path
+
+
+def known_env_id(env_id: str) -> str:
+    """A registered id (``sgc_env.check_env_id``), else a UsageError naming ``--env``."""
+    import sgc_env
+
+    try:
+        return sgc_env.check_env_id(env_id, "--env")
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def env_kwargs(text: str) -> dict[str, Any]:

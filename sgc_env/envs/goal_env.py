@@ -22,6 +22,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.defaults import POSITION_TOLERANCE
 from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
 
 __all__ = ["SGCGoalEnv"]
@@ -30,7 +31,7 @@ __all__ = ["SGCGoalEnv"]
 class SGCGoalEnv(SGCEnv):
     """:class:`SGCEnv` with a Dict observation (observation, achieved_goal, desired_goal)."""
 
-    def __init__(self, *args: Any, tolerance: float = 0.02, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, tolerance: float = POSITION_TOLERANCE, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._init_kwargs["tolerance"] = tolerance
         if not self.task.has_position[0]:

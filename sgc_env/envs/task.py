@@ -23,10 +23,10 @@ import numpy as np
 from sgc_env.observation import float32_residuals
 from sgc_env.paper.quaternion import log as rotvec_from_quat
 from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
-from sgc_env.paper.quaternion import rotate
+from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
 
-from .tracks import BodyTracks, Track, compile_tracks, unwrap_rotvec
+from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
     "BodyState",

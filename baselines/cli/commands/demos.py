@@ -6,9 +6,9 @@ import argparse
 from typing import Any
 
 from baselines.cli.checks import (
-    UsageError,
     env_kwargs,
     fraction,
+    known_env_id,
     nonneg_float,
     nonneg_int,
     out_file,
@@ -40,18 +40,6 @@ def push_options(args: argparse.Namespace) -> dict[str, Any]:
     }  # fmt: skip
 
 
-def check_env_id(env_id: str) -> None:
-    """A registered gymnasium id (``import sgc_env`` registers ours), else a UsageError."""
-    import gymnasium as gym
-
-    import sgc_env  # noqa: F401
-
-    try:
-        gym.spec(env_id)
-    except gym.error.Error as exc:
-        raise UsageError(f"--env: {exc}") from None
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--env", required=True, help="registered id with a flat observation")
     parser.add_argument("--episodes", type=positive_int, required=True)
@@ -69,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     from baselines.agents.demos import record_demos
     from baselines.agents.pushes import Pushes
 
-    check_env_id(args.env)
+    known_env_id(args.env)
     pushes = Pushes(**push_options(args))
     demos = record_demos(args.env, args.episodes, args.seed, args.env_kwargs or {}, pushes=pushes)
     path = demos.save(args.out)

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import (
+    known_env_id,
     nonneg_float,
     nonneg_int,
     out_dir,
@@ -24,6 +25,7 @@ from baselines.cli.checks import (
     positive_int,
     staged_output,
 )
+from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 
 __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
 
@@ -58,12 +60,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--episodes", type=positive_int, default=5, help="episodes per pair (default 5)"
     )
-    parser.add_argument("--seed", type=nonneg_int, default=1000, help="episode k uses seed + k")
-    parser.add_argument("--out", type=out_dir, default=None, help="output folder (see above)")
-    parser.add_argument("--tolerance-position", type=positive_float, default=0.02, metavar="M")
     parser.add_argument(
-        "--tolerance-orientation", type=positive_float, default=0.05, metavar="RAD"
+        "--seed", type=nonneg_int, default=EVAL_SEED,
+        help=f"episode k uses seed + k (default {EVAL_SEED})",
+    )  # fmt: skip
+    parser.add_argument("--out", type=out_dir, default=None, help="output folder (see above)")
+    parser.add_argument(
+        "--tolerance-position", type=positive_float, default=POSITION_TOLERANCE, metavar="M"
     )
+    parser.add_argument(
+        "--tolerance-orientation", type=positive_float, default=ORIENTATION_TOLERANCE,
+        metavar="RAD",
+    )  # fmt: skip
     parser.add_argument(
         "--tolerance-time", type=nonneg_float, default=None, metavar="S",
         help="success time tolerance (default: one control step)",
@@ -162,7 +170,6 @@ def _write_pair(result: Any, out: Path, plots: bool) -> None:
 def run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
-    from baselines.cli.commands.demos import check_env_id
     from baselines.evaluation import evaluate, json_ready
     from baselines.policies import policy_labels
     from sgc_env.metrics import Tolerances
@@ -178,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
             args.tolerance_position, args.tolerance_orientation, args.tolerance_time
         )
         for env_id in envs:
-            check_env_id(env_id)
+            known_env_id(env_id)
     except ValueError as exc:
         print(f"sgc evaluate: error: {exc}", file=sys.stderr)
         return 2

@@ -12,11 +12,13 @@ from baselines.cli.checks import (
     env_kwargs,
     existing_dir,
     existing_file,
+    known_env_id,
     nonneg_int,
     out_dir,
     positive_int,
 )
-from baselines.cli.commands.demos import add_push_arguments, check_env_id, push_options
+from baselines.cli.commands.demos import add_push_arguments, push_options
+from sgc_env.defaults import EVAL_SEED
 
 ALGOS = ("ppo", "sac", "td3", "her")
 
@@ -38,7 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="env steps between harness evaluations (0: off)",
     )  # fmt: skip
     parser.add_argument("--eval-episodes", type=positive_int, default=10)
-    parser.add_argument("--eval-seed", type=nonneg_int, default=10_000, help="first held-out seed")
+    parser.add_argument(
+        "--eval-seed", type=nonneg_int, default=EVAL_SEED, help="first held-out seed"
+    )
     parser.add_argument(
         "--checkpoint-freq", type=nonneg_int, default=0,
         help="env steps between checkpoints (0: off)",
@@ -76,7 +80,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.train import TrainConfig, train
 
-    check_env_id(args.env)
+    known_env_id(args.env)
     if args.init == "bc" and args.demos is None:
         raise UsageError("--init bc needs --demos (an npz from `sgc demos`)")
     pushes = {f"push_{key}": value for key, value in push_options(args).items()}
