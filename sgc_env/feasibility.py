@@ -19,7 +19,7 @@ from sgc_env.paper import quaternion as quat
 if TYPE_CHECKING:
     from sgc_env.scenario import Body, Scenario
 
-__all__ = ["BodyDemand", "body_demands", "inertia_diagonal", "inertia_bound"]
+__all__ = ["BodyDemand", "body_demand", "body_demands", "inertia_diagonal", "inertia_bound"]
 
 MAX_DEMAND_PERIODS = 600  # a plan sample costs ~0.3 ms: at most ~0.4 s per body
 
@@ -90,53 +90,52 @@ def _periods(ticks: int, goal_ticks: list[int], budget: int) -> list[int]:
 
 
 def body_demands(scenario: Scenario, periods: int | None = None) -> list[BodyDemand]:
-    """Peak demands per body of a resolved scenario, per control period up to the last goal.
+    """:func:`body_demand` of every body."""
+    return [body_demand(scenario, b, periods) for b in scenario.bodies]
+
+
+def body_demand(scenario: Scenario, b: Body, periods: int | None = None) -> BodyDemand:
+    """Peak demands of body ``b`` of a resolved scenario, per control period up to its last goal.
 
     A zero-order hold applies one force and torque per period, so the demand is the average
     over a period: ``m (v(t+dt) - v(t)) / dt - m g`` and ``(L(t+dt) - L(t)) / dt`` with the
     world-frame angular momentum ``L = R I R^T omega``; the instantaneous peak at the end of a
     course is higher but lasts a fraction of a period. ``periods`` caps how many periods are
-    examined (default ``MAX_DEMAND_PERIODS``; the ones around goal ticks always are).
+    examined (default ``MAX_DEMAND_PERIODS``; the ones around goal ticks always are). Raises
+    ValueError where the planner cannot plan the goals.
     """
     g = np.asarray(scenario.gravity, float)
     low, high = (np.asarray(w, float) for w in scenario.workspace)
     freq = scenario.control_frequency
     dt = 1.0 / freq
-    out = []
-    for b in scenario.bodies:
-        plan = _plan(b, freq)
-        inertia = np.diag(inertia_diagonal(b.shape, b.size, b.mass))
-        goal_ticks = [round(float(gl.time) * freq) for gl in b.goals]  # type: ignore[arg-type]
-        cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+    plan = _plan(b, freq)
+    inertia = np.diag(inertia_diagonal(b.shape, b.size, b.mass))
+    goal_ticks = [round(float(gl.time) * freq) for gl in b.goals]  # type: ignore[arg-type]
+    cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
-        def state(k: int, plan=plan, inertia=inertia, cache=cache):
-            if k not in cache:
-                s = plan.sample(k * dt)
-                rm = np.asarray(quat.to_matrix(s.orientation), float)
-                momentum = rm @ inertia @ rm.T @ s.angular_velocity
-                cache[k] = (s.position, s.velocity, s.angular_velocity, momentum)
-            return cache[k]
+    def state(k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        if k not in cache:
+            s = plan.sample(k * dt)
+            rm = np.asarray(quat.to_matrix(s.orientation), float)
+            momentum = rm @ inertia @ rm.T @ s.angular_velocity
+            cache[k] = (s.position, s.velocity, s.angular_velocity, momentum)
+        return cache[k]
 
-        peaks = dict.fromkeys(("force", "torque", "speed", "spin"), (0.0, 0.0))
-        outside = None
-        for k in _periods(max(goal_ticks), goal_ticks, periods or MAX_DEMAND_PERIODS):
-            x0, v0, w0, l0 = state(k)
-            x1, v1, w1, l1 = state(k + 1)
-            t = (k + 1) * dt
-            values = {
-                "force": b.mass * float(np.linalg.norm((v1 - v0) / dt - g)),
-                "torque": float(np.linalg.norm((l1 - l0) / dt)),
-                "speed": float(max(np.linalg.norm(v0), np.linalg.norm(v1))),
-                "spin": float(max(np.linalg.norm(w0), np.linalg.norm(w1))),
-            }
-            for key, value in values.items():
-                if value > peaks[key][0]:
-                    peaks[key] = (value, t)
-            if outside is None and not (np.all(low < x1) and np.all(x1 < high)):
-                outside = t
-        out.append(
-            BodyDemand(
-                *peaks["force"], *peaks["torque"], *peaks["speed"], *peaks["spin"], outside
-            )
-        )
-    return out
+    peaks = dict.fromkeys(("force", "torque", "speed", "spin"), (0.0, 0.0))
+    outside = None
+    for k in _periods(max(goal_ticks), goal_ticks, periods or MAX_DEMAND_PERIODS):
+        x0, v0, w0, l0 = state(k)
+        x1, v1, w1, l1 = state(k + 1)
+        t = (k + 1) * dt
+        values = {
+            "force": b.mass * float(np.linalg.norm((v1 - v0) / dt - g)),
+            "torque": float(np.linalg.norm((l1 - l0) / dt)),
+            "speed": float(max(np.linalg.norm(v0), np.linalg.norm(v1))),
+            "spin": float(max(np.linalg.norm(w0), np.linalg.norm(w1))),
+        }
+        for key, value in values.items():
+            if value > peaks[key][0]:
+                peaks[key] = (value, t)
+        if outside is None and not (np.all(low < x1) and np.all(x1 < high)):
+            outside = t
+    return BodyDemand(*peaks["force"], *peaks["torque"], *peaks["speed"], *peaks["spin"], outside)

@@ -864,10 +864,14 @@ def _goal_at(b: Body, t: float) -> int:
 @lru_cache(maxsize=64)
 def _check_plan(s: Scenario) -> None:
     """The analytic plan against the limits (cached: scenarios are frozen and hashable)."""
-    from sgc_env.feasibility import body_demands
+    from sgc_env.feasibility import body_demand
 
-    for i, (b, d) in enumerate(zip(s.bodies, body_demands(s), strict=True)):
+    for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
+        try:
+            d = body_demand(s, b)
+        except ValueError as exc:  # goals the planner cannot plan (e.g. too few ticks)
+            raise _fail(f"{p}.goals", str(exc)) from None
         if d.outside_time is not None:
             raise _fail(
                 f"{p}.goals[{_goal_at(b, d.outside_time)}]",
