@@ -43,7 +43,7 @@ BAD = [
     (["evaluate", "--episodes", "0"], "argument --episodes: expected an integer >= 1"),
     (["evaluate", "--episodes", "two"], "expected an integer, got 'two'"),
     (["evaluate", "--tolerance-position", "nan"], "expected a finite number"),
-    (["evaluate", "--env", "Nope-v0", "--out", "{tmp}"], "--env: Environment `Nope` doesn't"),
+    (["evaluate", "--env", "Nope-v0", "--out", "{tmp}"], "--env: unknown environment 'Nope-v0'"),
     (["rollout", "--seed", "-5"], "argument --seed"),
     (["rollout", "--out", "{file}"], "exists and is not a folder"),
     ([*DEMOS, "--out", "{tmp}"], "is a folder; give a file name"),
