@@ -81,6 +81,21 @@ def test_rejected_construction_leaves_no_client():
     assert connected_clients() == before
 
 
+def test_failure_after_the_client_exists_leaks_nothing(monkeypatch):
+    from sgc_env.simulator import Simulator
+
+    def broken(self, *args, **kwargs):
+        raise RuntimeError("no body today")
+
+    monkeypatch.setattr(Simulator, "add_body", broken)
+    gc.collect()
+    before = connected_clients()
+    for _ in range(5):
+        with pytest.raises(RuntimeError, match="no body today"):
+            gym.make("SGCRod-v0")
+    assert connected_clients() == before  # closed at once, not left to the garbage collector
+
+
 # ---------------------------------------------------------------- 2: simulator lifetime
 
 
