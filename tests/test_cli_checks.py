@@ -3,7 +3,6 @@ are moved into place only when a run finishes."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
@@ -11,17 +10,6 @@ import pytest
 
 from baselines.cli import main as cli
 from baselines.cli.checks import staged_output
-
-
-@pytest.fixture(autouse=True)
-def _importable_commands(monkeypatch):
-    """Build the parser from the commands that exist (others are written concurrently)."""
-    present = {
-        name: text
-        for name, text in cli.COMMANDS.items()
-        if importlib.util.find_spec(f"baselines.cli.commands.{name.replace('-', '_')}") is not None
-    }
-    monkeypatch.setattr(cli, "COMMANDS", present)
 
 
 @pytest.fixture
@@ -123,3 +111,23 @@ def test_interrupted_evaluate_keeps_the_earlier_results(tmp_path, monkeypatch, c
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert json.loads(before["summary.json"])["n_goals"] > 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ev"]
+
+
+def test_interrupted_demo_leaves_no_stub_video_beside_old_plates(tmp_path, monkeypatch):
+    import baselines.cli.demo as demo_module
+
+    out = tmp_path / "demo"
+    out.mkdir()
+    (out / "plates.png").write_bytes(b"earlier plates")
+    (out / "three_rods.mp4").write_bytes(b"earlier, whole video")
+
+    def interrupted(options, progress):
+        (options.out / "three_rods.mp4").write_bytes(b"48-byte stub")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(demo_module, "run_demo", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli.main(["demo", "--out", str(out), "--width", "96", "--height", "64"])
+    assert (out / "three_rods.mp4").read_bytes() == b"earlier, whole video"
+    assert (out / "plates.png").read_bytes() == b"earlier plates"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo"]
