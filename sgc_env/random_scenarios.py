@@ -168,7 +168,9 @@ def random_scenario(
         margin=cfg.margin,
         control_frequency=f,
     )
-    return resolve_scenario(scenario)
+    # The caps above bound what the plan needs; running the planner check here would cost
+    # 0.1-0.3 s per reset (measured on both presets), so tests check the bound instead.
+    return resolve_scenario(scenario, check_plan=False)
 
 
 def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, float]]:

@@ -15,7 +15,14 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 import sgc_env
 from sgc_env.envs import GoalEvent, SGCEnv, StepInfo
 from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS, float32_residuals
-from sgc_env.scenario import Body, Goal, Scenario, load_scenario
+from sgc_env.scenario import (
+    Body,
+    Goal,
+    Scenario,
+    ScenarioError,
+    load_scenario,
+    resolve_scenario,
+)
 
 
 def rollout(env: gym.Env, seed: int, steps: int) -> list[np.ndarray]:
@@ -259,13 +266,14 @@ def test_goal_ticks_advance_goals_and_report_errors():
     np.testing.assert_allclose(end_v, expected, rtol=1e-6)
 
 
-def _somersault_env(time: float) -> SGCEnv:
+def _somersault_env(time: float, check_plan: bool = True) -> SGCEnv:
     body = Body(
         "rod", shape="rod", size=(0.6, 0.03), position=(0.0, 0.0, 1.0),
         angular_velocity=(2.0 * math.pi, 0.0, 0.0),
         goals=(Goal(relative_rotation=(2.0 * math.pi, 0.0, 0.0), time=time),),
     )  # fmt: skip
-    return SGCEnv(Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0))
+    scenario = Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0)
+    return SGCEnv(resolve_scenario(scenario, check_plan=check_plan))
 
 
 def test_somersault_is_split_into_courses_tracked_continuously():
@@ -294,15 +302,21 @@ def test_somersault_is_split_into_courses_tracked_continuously():
 
 
 def test_somersault_without_enough_ticks_is_rejected():
-    with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
+    # The plan check splits the somersault on the env's ticks too, so it refuses it first.
+    with pytest.raises(ValueError, match=r"bodies\[0\]\.goals.*rotation of 6.28.*3 courses"):
         _somersault_env(2.0 / 60.0)
+    # Without the plan check the env's own course split still refuses it.
+    with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
+        _somersault_env(2.0 / 60.0, check_plan=False)
 
 
 def test_workspace_exit_terminates():
     body = Body("b", position=(0.0, 0.0, 0.0), linear_velocity=(30.0, 0.0, 0.0),
                 goals=(Goal(nail=(0.5, 0.0, 0.0), time=1.0),))  # fmt: skip
     s = Scenario(bodies=(body,), gravity=(0, 0, 0), workspace=((-1, -1, -1), (1, 1, 1)))
-    env = SGCEnv(s)
+    with pytest.raises(ScenarioError, match="force of 11"):  # the plan check sees it coming
+        resolve_scenario(s)
+    env = SGCEnv(resolve_scenario(s, check_plan=False))
     env.reset()
     for _ in range(10):
         _, _, terminated, truncated, _ = env.step(np.zeros(3, np.float32))
@@ -440,6 +454,6 @@ def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
         client = left_open.unwrapped.sim.client
         assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert made == [left_open.unwrapped, closed]
-    assert left_open.unwrapped.sim is None
+    assert left_open.unwrapped._closed
     assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert close_envs == made  # nested blocks: the autouse fixture saw them too

@@ -47,8 +47,8 @@ _ZERO13 = (0.0,) * 13
 
 
 class GoalEvent(TypedDict):
-    """A goal whose tick this is: the errors are the norms of D and phi at that tick (None for a
-    part the goal does not have)."""
+    """A goal whose tick this is: the errors are |D| and the angle between the body and the goal
+    orientation (in [0, pi]) at that tick (None for a part the goal does not have)."""
 
     body: int
     goal: int
@@ -98,6 +98,13 @@ class DistanceReward:
             if ev["orientation_error"] is not None:
                 reward += math.exp(-ev["orientation_error"] / self.bonus_angle)
         return reward
+
+
+def rotation_angle(phi: Sequence[float]) -> float:
+    """The angle (in [0, pi]) between the body and the goal orientation: ``|phi|`` folded,
+    because the unwrapped deviation can be longer than pi (7.35 rad is 1.07 rad away)."""
+    angle = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) % math.tau
+    return min(angle, math.tau - angle)
 
 
 def _course_fields(track: Track, k: int) -> tuple[float, ...]:
@@ -332,7 +339,7 @@ class GoalTask:
                             "orientation_error": None,
                         },
                     )
-                    ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+                    ev["orientation_error"] = rotation_angle(phi)
                 if k < to.size - 1:
                     self.ori_idx[i] = k + 1
                     start = to.course_start[k + 1]
