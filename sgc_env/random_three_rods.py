@@ -130,44 +130,58 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     )
 
 
-def _draw_specs(rng: np.random.Generator, cfg: RandomThreeRodsConfig) -> tuple[RodSpec, ...]:
-    specs = [_rod_spec(rng, base, cfg) for base in ROD_SPECS]
-    # The teal rod somersaults, as in the paper, in the middle third of its path after the ball.
-    teal = specs[SOMERSAULT_ROD]
-    first = teal.samples_before + teal.samples_after // 3
-    sample = int(rng.integers(first, first + max(1, teal.samples_after // 3)))
-    specs[SOMERSAULT_ROD] = replace(teal, somersault_sample=sample)
-    return tuple(specs)
+def _with_somersault(rng: np.random.Generator, spec: RodSpec) -> RodSpec:
+    """The somersault in the middle third of the path after the ball, as in the paper."""
+    first = spec.samples_before + spec.samples_after // 3
+    sample = int(rng.integers(first, first + max(1, spec.samples_after // 3)))
+    return replace(spec, somersault_sample=sample)
 
 
 def random_three_rods(
     rng: np.random.Generator, config: RandomThreeRodsConfig | None = None
 ) -> Scenario:
-    """Draw one resolved, feasible three-rod scene from ``rng`` (redraws infeasible ones)."""
+    """Draw one resolved, feasible three-rod scene from ``rng``.
+
+    The rods do not interact, so each is drawn on its own until it is feasible (a rejected
+    gold rod does not cost the teal and violet ones their plans)."""
+    cfg = config or RandomThreeRodsConfig()
+    rods = [_feasible_rod(rng, k, cfg) for k in range(len(ROD_SPECS))]
+    target = rods[0].props[-1]
+    return replace(
+        rods[0],
+        name="three_rods_random",
+        bodies=tuple(r.bodies[0] for r in rods),
+        props=(*(r.props[0] for r in rods), target),
+    )
+
+
+def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
+    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
     from sgc_env.random_scenarios import planner_demand  # it draws through this module
 
-    cfg = config or RandomThreeRodsConfig()
+    share = cfg.demand_share
     for _ in range(MAX_DRAWS):
-        specs = _draw_specs(rng, cfg)
-        data = build_three_rods(specs, name="three_rods_random")
+        spec = _rod_spec(rng, ROD_SPECS[k], cfg)
+        if k == SOMERSAULT_ROD:
+            spec = _with_somersault(rng, spec)
+        data = build_three_rods((spec,), name="three_rods_random")
         data["control_frequency"] = cfg.control_frequency
-        if not _enters_board(data, cfg.min_entry_cosine):
+        (body,) = data["bodies"]
+        if not _enters_board(body, cfg.min_entry_cosine):
             continue
-        for body in data["bodies"]:
-            body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
+        body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
         scenario = resolve_scenario(scenario_from_dict(data))
-        demand = planner_demand(scenario)
-        share = cfg.demand_share
-        if all(f <= share * cfg.force_limit and t <= share * cfg.torque_limit for f, t in demand):
+        ((force, torque),) = planner_demand(scenario)
+        if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
             return scenario
-    raise RuntimeError(f"no feasible three-rod scene in {MAX_DRAWS} draws: narrow the ranges")
+    raise RuntimeError(
+        f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
+        "the limits"
+    )
 
 
-def _enters_board(data: dict, min_cosine: float) -> bool:
-    """Every rod's last course (the embed) heads into the board steeply enough."""
-    for body in data["bodies"]:
-        hit, embed = (np.asarray(gl["nail"], float) for gl in body["goals"][-2:])
-        step = embed - hit
-        if step[0] / np.linalg.norm(step) < min_cosine:
-            return False
-    return True
+def _enters_board(body: dict, min_cosine: float) -> bool:
+    """The rod's last course (the embed) heads into the board steeply enough."""
+    hit, embed = (np.asarray(gl["nail"], float) for gl in body["goals"][-2:])
+    step = embed - hit
+    return bool(step[0] / np.linalg.norm(step) >= min_cosine)
