@@ -60,7 +60,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resets", type=int, default=20)
     args = parser.parse_args()
-    print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {"rods planned":>12s} {'check ms':>9s}")
+    print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}")
     for fixed, random_id, family in PAIRS:
         base = _reset_ms(fixed, args.resets)
         drawn = _reset_ms(random_id, args.resets)
