@@ -12,6 +12,7 @@ from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_sce
 
 __all__ = [
     "ENV_IDS",
+    "check_env_id",
     "Body",
     "Goal",
     "ObservationLayout",
@@ -36,3 +37,11 @@ ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
         gym.register(id=_id, entry_point=_entry, kwargs=_kwargs)
+
+
+def check_env_id(env_id: object, field: str = "env_id") -> str:
+    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
+    SGC ids (the one check of the package, the harness, training and the CLI)."""
+    if not isinstance(env_id, str) or env_id not in gym.registry:
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")
+    return env_id

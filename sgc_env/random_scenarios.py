@@ -199,7 +199,7 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
     (its series, term by term). Without an orientation track ``omega`` is the constant
     initial one.
     """
-    from sgc_env.paper.plan import BodyState, OrientationGoal, PositionGoal, plan_body
+    from sgc_env.paper.plan import BodyState, OrientationGoal, PlanOptions, PositionGoal, plan_body
 
     g = np.asarray(scenario.gravity, float)
     grid = np.linspace(1e-9, 1.0, samples)
@@ -218,6 +218,7 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
                              else np.asarray(gl.relative_rotation))
              for gl in b.goals if gl.has_orientation],
             end_velocity=b.end_velocity, end_angular_velocity=b.end_angular_velocity,
+            options=PlanOptions(control_frequency=scenario.control_frequency),
         )  # fmt: skip
         times = np.concatenate([c.t_start + (c.t_end - c.t_start) * grid for c in plan.courses])
         accel = plan.deviations(times, "position")[2]

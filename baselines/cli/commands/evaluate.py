@@ -16,6 +16,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
 __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
 
 #: (summary key, column title, format) of the comparison table.
@@ -47,10 +49,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
     parser.add_argument("--episodes", type=int, default=5, help="episodes per pair (default 5)")
-    parser.add_argument("--seed", type=int, default=1000, help="episode k uses seed + k")
+    parser.add_argument(
+        "--seed", type=int, default=EVAL_SEED, help=f"episode k uses seed + k (default {EVAL_SEED})"
+    )
     parser.add_argument("--out", type=Path, default=None, help="output folder (see above)")
-    parser.add_argument("--tolerance-position", type=float, default=0.02, metavar="M")
-    parser.add_argument("--tolerance-orientation", type=float, default=0.05, metavar="RAD")
+    parser.add_argument("--tolerance-position", type=float, default=POSITION_TOLERANCE, metavar="M")
+    parser.add_argument(
+        "--tolerance-orientation", type=float, default=ORIENTATION_TOLERANCE, metavar="RAD"
+    )
     parser.add_argument(
         "--tolerance-time", type=float, default=None, metavar="S",
         help="success time tolerance (default: one control step)",
