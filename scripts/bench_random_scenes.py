@@ -3,7 +3,8 @@
 For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
 the unwrapped env, the ratio random / fixed, how many feasibility checks (``planner_demand``
 calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
-one check.
+one check, and for scale the stepping time of a full-length episode of the random id (mean
+step time under seeded random actions times the episode's steps).
 
     .venv/bin/python scripts/bench_random_scenes.py [--resets 20]
 """
@@ -34,6 +35,25 @@ def _reset_ms(env_id: str, resets: int) -> float:
     return (time.perf_counter() - start) / resets * 1e3
 
 
+def _episode_ms(env_id: str, steps: int) -> float:
+    """Mean step time under seeded random actions (resets not timed) times the steps of a
+    full-length episode (``max_steps`` of seed 0's scene)."""
+    env = gym.make(env_id).unwrapped
+    env.action_space.seed(0)
+    env.reset(seed=0)
+    length = env.max_steps
+    elapsed, done = 0.0, False
+    for _ in range(steps):
+        if done:
+            env.reset()
+        start = time.perf_counter()
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        elapsed += time.perf_counter() - start
+        done = terminated or truncated
+    env.close()
+    return elapsed / steps * length * 1e3
+
+
 def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     """Checks per kept scene, and the mean ms of one check."""
     calls, seconds = [0], [0.0]
@@ -60,13 +80,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resets", type=int, default=20)
     args = parser.parse_args()
-    print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}")
+    print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}"
+          f" {'episode ms':>11s}")  # fmt: skip
     for fixed, random_id, family in PAIRS:
         base = _reset_ms(fixed, args.resets)
         drawn = _reset_ms(random_id, args.resets)
         draws, check_ms = _draws_per_scene(family, args.resets)
+        episode = _episode_ms(random_id, 2000)
         print(f"{fixed:24s} {base:9.2f}")
-        print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}")
+        print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
+              f" {episode:11.1f}")  # fmt: skip
 
 
 if __name__ == "__main__":
