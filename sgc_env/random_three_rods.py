@@ -4,12 +4,14 @@ balls and target times drawn from the env's ``np_random`` on every reset.
 Each rod's path is the cubic spline through the paper's waypoints moved by drawn offsets
 (the hit point stays on the target face); the goal counts before and after the ball, the
 pierce and hit times, the balls' velocities and where the teal rod turns its somersault are
-drawn too. Rods, balls and the target board keep their geometry and limits, so the
-observation and action spaces are those of ``SGCThreeRods-v0`` for every draw.
+drawn too. Rods, balls and the target board keep their geometry, so the observation and action
+spaces are those of ``SGCThreeRods-v0`` for every draw; the limits are constants of the id
+(twice the paper scene's).
 
-Feasibility: a draw is kept only if bounds of the force and torque along the analytic plan
-(``planner_demand``) stay inside the limits; otherwise it is redrawn. Planning three rods costs
-far more than a reset of a fixed scene (``docs/environments.md`` has the figures).
+Feasibility: a rod is kept only if bounds of the force and torque along its analytic plan
+(``planner_demand``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
+Planning the rods costs far more than a reset of a fixed scene (``docs/environments.md`` has
+the figures).
 ``tests/test_random_scenes.py`` runs the expert inside PyBullet on the draws.
 """
 
