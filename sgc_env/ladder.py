@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
+from functools import cache
 
 import gymnasium as gym
 
@@ -88,8 +89,14 @@ def _row(rung: Rung) -> dict[str, str]:
     return row
 
 
+@cache
+def _rows() -> tuple[dict[str, str], ...]:
+    """One row per rung (making the random three-rod env draws a scene: made once)."""
+    return tuple(_row(r) for r in LADDER)
+
+
 def _table(columns: tuple[str, ...]) -> str:
-    rows = [_row(r) for r in LADDER]
+    rows = _rows()
     lines = ["| rung | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     lines += [
         f"| {i} | " + " | ".join(row[c] for c in columns) + " |" for i, row in enumerate(rows, 1)
