@@ -398,3 +398,48 @@ def test_one_env_id_check_names_the_field_and_the_ids():
         sgc_env.check_env_id("Nope-v0", "env")
     with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
         sgc_env.check_env_id(3)
+
+
+def test_dense_reward_is_its_documented_formula():
+    """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
+    current course's start deviations, floored at 0.1 m and 0.5 rad)."""
+    env = gym.make("SGCRod-v0")
+    obs, _ = env.reset(seed=3)
+    lay = env.unwrapped.layout
+    rng = np.random.default_rng(0)
+    bonus_ticks = 0
+    for _ in range(150):
+        a = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, info = env.step(a)
+        scale_l = max(np.linalg.norm(obs[lay.body_slice(0, "position_course_start")]), 0.1)
+        scale_a = max(np.linalg.norm(obs[lay.body_slice(0, "orientation_course_start")]), 0.5)
+        expected = -(
+            np.linalg.norm(info["position_deviation"][0]) / scale_l
+            + np.linalg.norm(info["orientation_deviation"][0]) / scale_a
+        ) - 0.01 * np.mean(a.astype(np.float64) ** 2)
+        for ev in info.get("goal_reached", []):
+            bonus_ticks += 1
+            if ev["position_error"] is not None:
+                expected += math.exp(-ev["position_error"] / 0.01)
+            if ev["orientation_error"] is not None:
+                expected += math.exp(-ev["orientation_error"] / 0.02)
+        assert reward == pytest.approx(expected, rel=1e-5, abs=1e-9)
+        if terminated or truncated:
+            break
+    assert bonus_ticks > 0
+    env.close()
+
+
+def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
+    from conftest import closing_every_env
+
+    with closing_every_env() as made:
+        left_open = gym.make("SGCPoint-v0")
+        closed = SGCEnv("point_three_goals")
+        closed.close()
+        client = left_open.unwrapped.sim.client
+        assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert made == [left_open.unwrapped, closed]
+    assert left_open.unwrapped.sim is None
+    assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert close_envs == made  # nested blocks: the autouse fixture saw them too

@@ -467,7 +467,7 @@ class SGCEnv(gym.Env):
             events, changed = task.advance(self._tick)
             if changed:
                 self._observe(read=False)
-        reward = task.reward(values, events)
+        reward = task.reward_function(task, values, events)
         terminated = self._failed
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
