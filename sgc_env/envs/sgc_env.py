@@ -63,10 +63,10 @@ goal orientation, in [0, pi], at that tick; None for a missing part).
 
 ## Arguments
 
-``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
-:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
-reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
-an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
+``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
+(240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
 distance, yaw, pitch, target, width, height). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
@@ -79,7 +79,7 @@ import math
 import struct
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypedDict
 
@@ -87,7 +87,7 @@ import gymnasium as gym
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
@@ -205,7 +205,7 @@ class SGCEnv(gym.Env):
         self,
         scenario: Scenario | str | Path | None = None,
         *,
-        random_scenario: RandomScenarioConfig | str | None = None,
+        random_scenario: SceneFamily | str | None = None,
         control_frequency: int | None = None,
         sim_frequency: int = 240,
         time_grid: str | None = None,
@@ -225,13 +225,11 @@ class SGCEnv(gym.Env):
             )
         self.render_mode = render_mode
         self.camera = CameraConfig.from_dict(camera)
-        self._random_config: RandomScenarioConfig | None = None
+        self._random_config: SceneFamily | None = None
         if scenario is None:
             cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
             if control_frequency is not None:
-                cfg = RandomScenarioConfig(
-                    **{**cfg.__dict__, "control_frequency": control_frequency}
-                )
+                cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
