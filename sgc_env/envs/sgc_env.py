@@ -8,12 +8,19 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz in the world frame,
-scaled by the body's ``force_limit`` (N) and ``torque_limit`` (N m). When every body is a
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
+``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
+``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
+that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
+axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
+start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
+its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
+1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
+orientation goal; scaled body axes make every axis equally sensitive. When every body is a
 sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
 the centre of mass; gravity is *not* compensated. The action is held for one control period
 (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep.
+every substep (the world torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -302,7 +309,11 @@ class SGCEnv(gym.Env):
         self._init_caches()
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
-        self._tlimit = [float(b.torque_limit) for b in s.bodies]
+        self.torque_scale = np.array(
+            [float(b.torque_limit) * inertia / inertia.max()
+             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        )  # fmt: skip
+        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
@@ -526,7 +537,7 @@ class SGCEnv(gym.Env):
         drives: list[Drive] = []
         applied_f: list[float] = []
         applied_t: list[float] = []
-        for i, (pos, _, lin, _) in enumerate(self._states):
+        for i, (pos, orn, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
             fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
@@ -534,8 +545,8 @@ class SGCEnv(gym.Env):
             applied_f += f
             tq = None
             if use_torque:
-                tl = self._tlimit[i]
-                tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
+                sx, sy, sz = self._tscale[i]
+                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
