@@ -49,6 +49,7 @@ _TRACKS = ("position", "orientation")
 _MODEL_ATTRIBUTES = (
     "scenario",
     "body_inertia",
+    "torque_scale",
     "layout",
     "sim_frequency",
     "substeps",

@@ -174,7 +174,10 @@ def random_scenario(
 def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, float]]:
     """Peak |force| and |torque| per body along the analytic SGC plan (``sgc_env.paper.plan``).
 
-    Force = m (a - g); torque bounded by I_max |alpha| + I_max |omega|^2 (gyroscopic term).
+    Force = m (a - g); torque bounded by I_max |alpha| + I_max |omega|^2 (gyroscopic term). The
+    torque action about body axis k is (I_k alpha_k + gyro_k) / (torque_limit I_k / I_max), and
+    |gyro_k| <= I_k |omega|^2 (principal moments obey I_k >= |I_j - I_l|), so the same bound
+    below ``torque_limit`` keeps every axis of the scaled torque action below 1.
     Costly (milliseconds), so the env does not call it on every reset; tests use it to show
     that the limits from the geometric bound cover what the plan needs.
     """

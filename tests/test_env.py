@@ -361,6 +361,25 @@ def test_goal_env_compute_reward_is_vectorised():
     assert env.compute_reward(a, d, [{}, {}]).tolist() == [0.0, -1.0]
 
 
+def test_goal_env_charges_the_steps_a_failure_leaves():
+    env = gym.make("SGCPointGoal-v0")
+    env.reset(seed=0)
+    base = env.unwrapped
+    terminated = False
+    while not terminated:
+        obs, reward, terminated, truncated, info = env.step(np.ones(3))
+        assert not truncated
+    left = base.max_steps - base._tick
+    assert left > 0 and info["failure_charge"] == left
+    assert reward == -1.0 - left
+    # HER recomputes rewards with the stored infos: the charge survives relabelling
+    goal = obs["achieved_goal"][None]
+    relabelled = base.compute_reward(goal, goal, [info])
+    assert relabelled.tolist() == [-float(left)]
+    with pytest.raises(ValueError, match="reward modes apply to SGCEnv"):
+        gym.make("SGCPointGoal-v0", reward="sparse")
+
+
 def test_goal_env_with_her():
     from stable_baselines3 import SAC, HerReplayBuffer
 
