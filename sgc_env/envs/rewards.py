@@ -1,9 +1,9 @@
-"""The env's reward modes: one small object per mode, computed from one step's record.
+"""The env's reward modes: one small object per mode, called once per control step.
 
-Every mode reads the same things the observation carries (per body and track: the deviation
-``D``, the time left, the course's start deviation ``D_i(0)`` and duration ``T_i``, the end
-velocity after the last goal, the flags), the clipped action and the goal-tick events, so a
-reward is a function of what the agent observes plus the goal errors of that tick.
+Every mode reads what the observation carries (per body and track: the deviation ``D``, the
+time left, the course's start deviation ``D_i(0)`` and duration ``T_i``, the end velocity after
+the last goal), the clipped action and the goal-tick events, so a reward is a function of what
+the agent observes plus the goal errors of that tick.
 
 ``schedule`` (the default), per step::
 
@@ -41,14 +41,20 @@ per-track cost capped at 1 no state is worse than that. ``distance`` keeps its o
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-import numpy as np
-
-from sgc_env.observation import ObservationLayout
-
-__all__ = ["REWARD_MODES", "EFFORT_WEIGHT", "make_reward"]
+__all__ = [
+    "EFFORT_WEIGHT",
+    "REWARD_MODES",
+    "BodyTracks",
+    "SparseReward",
+    "TrackReward",
+    "TrackState",
+    "distance_cost",
+    "make_reward",
+    "schedule_cost",
+]
 
 REWARD_MODES: tuple[str, ...] = ("schedule", "distance", "sparse")
 EFFORT_WEIGHT = 0.01
@@ -58,30 +64,20 @@ TRACK_COST_CAP = 1.0
 BONUS_POSITION = 0.01  # m
 BONUS_ORIENTATION = 0.02  # rad
 
-_TRACK_FIELDS = ("deviation", "time_left", "course_start", "course_duration", "end_velocity",
-                 "flags")  # fmt: skip
+TrackState = tuple[Sequence[float], float, Sequence[float]]
+"""One track of one body after a step: deviation (D or phi, first 3 entries read), time left
+to the current goal, and the course's 13 observation entries (start deviation 3, duration 1,
+next start 3, next duration 1, end velocity 3, flags: has a track, is the last goal)."""
 
-
-def _columns() -> list[int]:
-    """Block offsets of each track's fields, in the order :func:`_track_terms` reads them."""
-    layout = ObservationLayout(1)
-    cols: list[int] = []
-    for track in ("position", "orientation"):
-        for name in _TRACK_FIELDS:
-            sl = layout.body_slice(0, f"{track}_{name}")
-            cols += range(sl.start, sl.stop)
-    return cols
-
-
-_COLUMNS = _columns()
-_PER_TRACK = 13  # 3 + 1 + 3 + 1 + 3 + 2
+BodyTracks = tuple[TrackState | None, TrackState | None]
+"""Position and orientation track of one body (None where the body has no such track)."""
 
 
 def _effort(action: Sequence[float]) -> float:
     return EFFORT_WEIGHT * sum([x * x for x in action]) / len(action)
 
 
-def _bonus(events: Sequence[dict[str, Any]]) -> float:
+def _bonus(events: Sequence[Mapping[str, Any]]) -> float:
     total = 0.0
     for ev in events:
         if ev["position_error"] is not None:
@@ -91,61 +87,57 @@ def _bonus(events: Sequence[dict[str, Any]]) -> float:
     return total
 
 
-def _track_rows(block: np.ndarray) -> list[list[float]]:
-    """Per body: the 26 track entries (position then orientation) as plain floats."""
-    return block[:, _COLUMNS].tolist()
+def _scale(course: Sequence[float], floor: float) -> float:
+    sx, sy, sz = course[0], course[1], course[2]
+    return max(math.sqrt(sx * sx + sy * sy + sz * sz), floor)
 
 
-def _schedule_cost(v: list[float], o: int, floor: float) -> float:
-    """``min(|D - D_sched| / L, 1)`` of the track starting at ``v[o]`` (0 without a track)."""
-    if v[o + 11] < 0.5:
-        return 0.0
-    dx, dy, dz, left = v[o], v[o + 1], v[o + 2], v[o + 3]
-    sx, sy, sz = v[o + 4], v[o + 5], v[o + 6]
+def schedule_cost(track: TrackState, floor: float) -> float:
+    """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
+    d, left, c = track
     if left >= 0.0:
-        f = left / v[o + 7]
-        rx, ry, rz = sx * f, sy * f, sz * f
+        f = left / c[3]
+        rx, ry, rz = c[0] * f, c[1] * f, c[2] * f
     else:
-        rx, ry, rz = -v[o + 8] * left, -v[o + 9] * left, -v[o + 10] * left
-    ex, ey, ez = dx - rx, dy - ry, dz - rz
-    scale = max(math.sqrt(sx * sx + sy * sy + sz * sz), floor)
-    return min(math.sqrt(ex * ex + ey * ey + ez * ez) / scale, TRACK_COST_CAP)
+        rx, ry, rz = -c[8] * left, -c[9] * left, -c[10] * left
+    ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
+    return min(math.sqrt(ex * ex + ey * ey + ez * ez) / _scale(c, floor), TRACK_COST_CAP)
 
 
-def _distance_cost(v: list[float], o: int, floor: float) -> float:
-    if v[o + 11] < 0.5:
-        return 0.0
-    dx, dy, dz = v[o], v[o + 1], v[o + 2]
-    sx, sy, sz = v[o + 4], v[o + 5], v[o + 6]
-    scale = max(math.sqrt(sx * sx + sy * sy + sz * sz), floor)
-    return math.sqrt(dx * dx + dy * dy + dz * dz) / scale
+def distance_cost(track: TrackState, floor: float) -> float:
+    """``|D| / L`` (uncapped, as before the reward modes)."""
+    d, _, c = track
+    return math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / _scale(c, floor)
 
 
 class TrackReward:
     """Dense modes: a per-track cost averaged over bodies, effort, bonuses, failure charge."""
 
-    def __init__(self, cost, charge_failure: bool) -> None:
+    def __init__(self, cost: Callable[[TrackState, float], float], charge_failure: bool) -> None:
         self._cost = cost
         self._charge_failure = charge_failure
 
     def __call__(
         self,
-        block: np.ndarray,
+        bodies: Sequence[BodyTracks],
         action: Sequence[float],
-        events: Sequence[dict[str, Any]],
+        events: Sequence[Mapping[str, Any]],
         terminated: bool,
         steps_left: int,
     ) -> float:
-        """Reward of one step; ``block`` is the (bodies, block) double record of the step."""
-        rows = _track_rows(block)
-        cost = sum(
-            self._cost(v, 0, POSITION_FLOOR) + self._cost(v, _PER_TRACK, ORIENTATION_FLOOR)
-            for v in rows
-        ) / len(rows)
-        reward = -cost - _effort(action) + _bonus(events)
+        """Reward of one step from every body's tracks after it and the clipped action."""
+        cost, tracks = 0.0, 0
+        for position, orientation in bodies:
+            if position is not None:
+                cost += self._cost(position, POSITION_FLOOR)
+                tracks += 1
+            if orientation is not None:
+                cost += self._cost(orientation, ORIENTATION_FLOOR)
+                tracks += 1
+        n = len(bodies)
+        reward = -cost / n - _effort(action) + _bonus(events)
         if terminated and self._charge_failure:
-            tracks = sum((v[11] > 0.5) + (v[_PER_TRACK + 11] > 0.5) for v in rows) / len(rows)
-            reward -= (TRACK_COST_CAP * tracks + EFFORT_WEIGHT) * steps_left
+            reward -= (TRACK_COST_CAP * tracks / n + EFFORT_WEIGHT) * steps_left
         return reward
 
 
@@ -154,9 +146,9 @@ class SparseReward:
 
     def __call__(
         self,
-        block: np.ndarray,
+        bodies: Sequence[BodyTracks],
         action: Sequence[float],
-        events: Sequence[dict[str, Any]],
+        events: Sequence[Mapping[str, Any]],
         terminated: bool,
         steps_left: int,
     ) -> float:
@@ -169,9 +161,9 @@ class SparseReward:
 def make_reward(mode: str) -> TrackReward | SparseReward:
     """The reward object of ``mode`` (one of :data:`REWARD_MODES`)."""
     if mode == "schedule":
-        return TrackReward(_schedule_cost, charge_failure=True)
+        return TrackReward(schedule_cost, charge_failure=True)
     if mode == "distance":
-        return TrackReward(_distance_cost, charge_failure=False)
+        return TrackReward(distance_cost, charge_failure=False)
     if mode == "sparse":
         return SparseReward()
     raise ValueError(f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)}")
