@@ -78,10 +78,10 @@ class EnvModel:
         expert passes tuples; plain floats keep its control step cheap). ``orientations``:
         each body's quaternion (xyzw) at the start of the step, which the env uses to turn the
         body-axis torque action into a world torque (``R0 (torque_scale * a)``); here the
-        inverse, ``R0^T tau / torque_scale``, so the env applies exactly ``tau``. The action is float64
-        on purpose: rounding it to the float32 of the action space moves a thin rod's
-        orientation at a goal by up to ~1e-9 rad (its axial inertia amplifies the rounding of
-        the world torque), and the env uses whatever precision it is given.
+        inverse, ``R0^T tau / torque_scale``, so the env applies exactly ``tau``. The action is
+        float64 on purpose: the env uses whatever precision it is given, and rounding the torque
+        to the float32 of the action space moved a thin rod's orientation at a goal by up to
+        ~1e-9 rad under world-frame torques.
         """
         n = len(self.bodies)
         if isinstance(forces, np.ndarray):

@@ -41,6 +41,7 @@ class SGCGoalEnv(SGCEnv):
                 "(compute_reward); reward modes apply to SGCEnv ids only"
             )
         super().__init__(*args, **kwargs)
+        del self._init_kwargs["reward"]  # the base mode is unused here; pickles re-make it
         self._init_kwargs["tolerance"] = tolerance
         if not self.task.has_position[0]:
             raise ValueError("the goal-conditioned env needs a position track on body 0")

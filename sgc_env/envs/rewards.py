@@ -1,4 +1,4 @@
-"""The env's reward modes: one small object per mode, called once per control step.
+"""The env's reward modes: one :class:`~sgc_env.envs.task.RewardFunction` per mode.
 
 Every mode reads what the observation carries (per body and track: the deviation ``D``, the
 time left, the course's start deviation ``D_i(0)`` and duration ``T_i``, the end velocity after
@@ -41,19 +41,19 @@ per-track cost capped at 1 no state is worse than that. ``distance`` keeps its o
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
+
+from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction
 
 __all__ = [
     "EFFORT_WEIGHT",
     "REWARD_MODES",
-    "BodyTracks",
+    "ScheduleReward",
     "SparseReward",
-    "TrackReward",
     "TrackState",
-    "distance_cost",
     "make_reward",
     "schedule_cost",
+    "tracks_of",
 ]
 
 REWARD_MODES: tuple[str, ...] = ("schedule", "distance", "sparse")
@@ -69,15 +69,12 @@ TrackState = tuple[Sequence[float], float, Sequence[float]]
 to the current goal, and the course's 13 observation entries (start deviation 3, duration 1,
 next start 3, next duration 1, end velocity 3, flags: has a track, is the last goal)."""
 
-BodyTracks = tuple[TrackState | None, TrackState | None]
-"""Position and orientation track of one body (None where the body has no such track)."""
-
 
 def _effort(action: Sequence[float]) -> float:
     return EFFORT_WEIGHT * sum([x * x for x in action]) / len(action)
 
 
-def _bonus(events: Sequence[Mapping[str, Any]]) -> float:
+def _bonus(events: Sequence[GoalEvent]) -> float:
     total = 0.0
     for ev in events:
         if ev["position_error"] is not None:
@@ -85,11 +82,6 @@ def _bonus(events: Sequence[Mapping[str, Any]]) -> float:
         if ev["orientation_error"] is not None:
             total += math.exp(-ev["orientation_error"] / BONUS_ORIENTATION)
     return total
-
-
-def _scale(course: Sequence[float], floor: float) -> float:
-    sx, sy, sz = course[0], course[1], course[2]
-    return max(math.sqrt(sx * sx + sy * sy + sz * sz), floor)
 
 
 def schedule_cost(track: TrackState, floor: float) -> float:
@@ -101,42 +93,45 @@ def schedule_cost(track: TrackState, floor: float) -> float:
     else:
         rx, ry, rz = -c[8] * left, -c[9] * left, -c[10] * left
     ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
-    return min(math.sqrt(ex * ex + ey * ey + ez * ez) / _scale(c, floor), TRACK_COST_CAP)
+    scale = max(math.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
+    return min(math.sqrt(ex * ex + ey * ey + ez * ez) / scale, TRACK_COST_CAP)
 
 
-def distance_cost(track: TrackState, floor: float) -> float:
-    """``|D| / L`` (uncapped, as before the reward modes)."""
-    d, _, c = track
-    return math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / _scale(c, floor)
+def tracks_of(task: GoalTask) -> list[tuple[TrackState | None, TrackState | None]]:
+    """Every body's position and orientation :data:`TrackState` (None without the track)."""
+    return [
+        (
+            (task.deviations[i], task.position_time_left[i], task.position_course[i])
+            if task.has_position[i] else None,
+            (task.phi[i], task.orientation_time_left[i], task.orientation_course[i])
+            if task.has_orientation[i] else None,
+        )
+        for i in range(task.n_bodies)
+    ]  # fmt: skip
 
 
-class TrackReward:
-    """Dense modes: a per-track cost averaged over bodies, effort, bonuses, failure charge."""
-
-    def __init__(self, cost: Callable[[TrackState, float], float], charge_failure: bool) -> None:
-        self._cost = cost
-        self._charge_failure = charge_failure
+class ScheduleReward:
+    """The default: distance from the on-schedule deviation, effort, bonuses, failure charge."""
 
     def __call__(
         self,
-        bodies: Sequence[BodyTracks],
+        task: GoalTask,
         action: Sequence[float],
-        events: Sequence[Mapping[str, Any]],
-        terminated: bool,
-        steps_left: int,
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
     ) -> float:
-        """Reward of one step from every body's tracks after it and the clipped action."""
         cost, tracks = 0.0, 0
-        for position, orientation in bodies:
+        for position, orientation in tracks_of(task):
             if position is not None:
-                cost += self._cost(position, POSITION_FLOOR)
+                cost += schedule_cost(position, POSITION_FLOOR)
                 tracks += 1
             if orientation is not None:
-                cost += self._cost(orientation, ORIENTATION_FLOOR)
+                cost += schedule_cost(orientation, ORIENTATION_FLOOR)
                 tracks += 1
-        n = len(bodies)
+        n = task.n_bodies
         reward = -cost / n - _effort(action) + _bonus(events)
-        if terminated and self._charge_failure:
+        if terminated:
             reward -= (TRACK_COST_CAP * tracks / n + EFFORT_WEIGHT) * steps_left
         return reward
 
@@ -146,11 +141,11 @@ class SparseReward:
 
     def __call__(
         self,
-        bodies: Sequence[BodyTracks],
+        task: GoalTask,
         action: Sequence[float],
-        events: Sequence[Mapping[str, Any]],
-        terminated: bool,
-        steps_left: int,
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
     ) -> float:
         reward = -_effort(action) + _bonus(events)
         if terminated:
@@ -158,12 +153,12 @@ class SparseReward:
         return reward
 
 
-def make_reward(mode: str) -> TrackReward | SparseReward:
-    """The reward object of ``mode`` (one of :data:`REWARD_MODES`)."""
+def make_reward(mode: str) -> RewardFunction:
+    """The reward function of ``mode`` (one of :data:`REWARD_MODES`)."""
     if mode == "schedule":
-        return TrackReward(schedule_cost, charge_failure=True)
+        return ScheduleReward()
     if mode == "distance":
-        return TrackReward(distance_cost, charge_failure=False)
+        return DistanceReward(EFFORT_WEIGHT, BONUS_POSITION, BONUS_ORIENTATION)
     if mode == "sparse":
         return SparseReward()
     raise ValueError(f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)}")

@@ -67,10 +67,17 @@ class TaskCounters(TypedDict):
 
 class RewardFunction(Protocol):
     """The reward of one control step, from the task after the step (its deviations, current
-    courses and tracks), the clipped action values and the goal events of the step."""
+    courses and tracks), the clipped action values and the goal events of the step; on a failure
+    (``terminated``) also the number of steps the episode had left, so a mode can charge them
+    (modes: :mod:`sgc_env.envs.rewards`)."""
 
     def __call__(
-        self, task: GoalTask, action: Sequence[float], events: Sequence[GoalEvent]
+        self,
+        task: GoalTask,
+        action: Sequence[float],
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
     ) -> float: ...
 
 
@@ -88,8 +95,14 @@ class DistanceReward:
         self.bonus_angle = bonus_angle
 
     def __call__(
-        self, task: GoalTask, action: Sequence[float], events: Sequence[GoalEvent]
+        self,
+        task: GoalTask,
+        action: Sequence[float],
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
     ) -> float:
+        """``terminated`` and ``steps_left`` are ignored: this reward charges no failure."""
         cost = 0.0
         phis, pscale, oscale = task.phi, task.position_scale, task.orientation_scale
         has_pos, has_ori = task.has_position, task.has_orientation
@@ -346,8 +359,14 @@ class GoalTask:
         self.next_event = self._first_pending_tick(tick)
         return events, any_changed
 
-    def reward(self, action: Sequence[float], events: Sequence[GoalEvent]) -> float:
-        return self.reward_function(self, action, events)
+    def reward(
+        self,
+        action: Sequence[float],
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
+    ) -> float:
+        return self.reward_function(self, action, events, terminated, steps_left)
 
     # ---------------------------------------------------------------- goal-conditioned view
 
