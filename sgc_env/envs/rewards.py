@@ -41,16 +41,20 @@ per-track cost capped at 1 no state is worse than that. ``distance`` keeps its o
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
-from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction
+if TYPE_CHECKING:
+    from .task import GoalEvent, GoalTask, RewardFunction
 
 __all__ = [
     "EFFORT_WEIGHT",
     "REWARD_MODES",
+    "DistanceReward",
     "ScheduleReward",
     "SparseReward",
     "TrackState",
+    "distance_cost",
     "make_reward",
     "schedule_cost",
     "tracks_of",
@@ -84,6 +88,10 @@ def _bonus(events: Sequence[GoalEvent]) -> float:
     return total
 
 
+def _norm(v: Sequence[float]) -> float:
+    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+
+
 def schedule_cost(track: TrackState, floor: float) -> float:
     """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
     d, left, c = track
@@ -92,26 +100,37 @@ def schedule_cost(track: TrackState, floor: float) -> float:
         rx, ry, rz = c[0] * f, c[1] * f, c[2] * f
     else:
         rx, ry, rz = -c[8] * left, -c[9] * left, -c[10] * left
-    ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
-    scale = max(math.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
-    return min(math.sqrt(ex * ex + ey * ey + ez * ez) / scale, TRACK_COST_CAP)
+    error = _norm((d[0] - rx, d[1] - ry, d[2] - rz))
+    return min(error / max(_norm(c), floor), TRACK_COST_CAP)
 
 
-def tracks_of(task: GoalTask) -> list[tuple[TrackState | None, TrackState | None]]:
-    """Every body's position and orientation :data:`TrackState` (None without the track)."""
-    return [
-        (
-            (task.deviations[i], task.position_time_left[i], task.position_course[i])
-            if task.has_position[i] else None,
-            (task.phi[i], task.orientation_time_left[i], task.orientation_course[i])
-            if task.has_orientation[i] else None,
-        )
-        for i in range(task.n_bodies)
-    ]  # fmt: skip
+def distance_cost(track: TrackState, floor: float) -> float:
+    """``|D| / L`` (uncapped)."""
+    d, _, c = track
+    return _norm(d) / max(_norm(c), floor)
 
 
-class ScheduleReward:
-    """The default: distance from the on-schedule deviation, effort, bonuses, failure charge."""
+def tracks_of(task: GoalTask) -> list[tuple[TrackState, float]]:
+    """Every track of every body with the floor of its scale (m for position, rad)."""
+    out = []
+    for i in range(task.n_bodies):
+        if task.has_position[i]:
+            track = (task.deviations[i], task.position_time_left[i], task.position_course[i])
+            out.append((track, POSITION_FLOOR))
+        if task.has_orientation[i]:
+            track = (task.phi[i], task.orientation_time_left[i], task.orientation_course[i])
+            out.append((track, ORIENTATION_FLOOR))
+    return out
+
+
+class _ModeReward:
+    """``-mean_b sum_tracks cost - effort + bonus``, and on a failure the steps left charged at
+    the worst per-step reward (where the mode charges failures; its costs must then be capped
+    at :data:`TRACK_COST_CAP`)."""
+
+    def __init__(self, cost: Callable[[TrackState, float], float] | None, charge: bool) -> None:
+        self._cost = cost
+        self._charge = charge
 
     def __call__(
         self,
@@ -121,44 +140,43 @@ class ScheduleReward:
         terminated: bool = False,
         steps_left: int = 0,
     ) -> float:
-        cost, tracks = 0.0, 0
-        for position, orientation in tracks_of(task):
-            if position is not None:
-                cost += schedule_cost(position, POSITION_FLOOR)
-                tracks += 1
-            if orientation is not None:
-                cost += schedule_cost(orientation, ORIENTATION_FLOOR)
-                tracks += 1
+        cost = worst = 0.0
+        if self._cost is not None:
+            for track, floor in tracks_of(task):
+                cost += self._cost(track, floor)
+                worst += TRACK_COST_CAP
         n = task.n_bodies
         reward = -cost / n - _effort(action) + _bonus(events)
-        if terminated:
-            reward -= (TRACK_COST_CAP * tracks / n + EFFORT_WEIGHT) * steps_left
+        if terminated and self._charge:
+            reward -= (worst / n + EFFORT_WEIGHT) * steps_left
         return reward
 
 
-class SparseReward:
+class ScheduleReward(_ModeReward):
+    """The default: distance from the on-schedule deviation (capped), effort, bonuses, and the
+    failure charge."""
+
+    def __init__(self) -> None:
+        super().__init__(schedule_cost, charge=True)
+
+
+class DistanceReward(_ModeReward):
+    """The reward before the modes: ``|D| / L`` per track, effort, bonuses, no failure charge."""
+
+    def __init__(self) -> None:
+        super().__init__(distance_cost, charge=False)
+
+
+class SparseReward(_ModeReward):
     """Goal-tick bonuses and effort only; a failure charges the worst effort per step left."""
 
-    def __call__(
-        self,
-        task: GoalTask,
-        action: Sequence[float],
-        events: Sequence[GoalEvent],
-        terminated: bool = False,
-        steps_left: int = 0,
-    ) -> float:
-        reward = -_effort(action) + _bonus(events)
-        if terminated:
-            reward -= EFFORT_WEIGHT * steps_left
-        return reward
+    def __init__(self) -> None:
+        super().__init__(None, charge=True)
 
 
 def make_reward(mode: str) -> RewardFunction:
     """The reward function of ``mode`` (one of :data:`REWARD_MODES`)."""
-    if mode == "schedule":
-        return ScheduleReward()
-    if mode == "distance":
-        return DistanceReward(EFFORT_WEIGHT, BONUS_POSITION, BONUS_ORIENTATION)
-    if mode == "sparse":
-        return SparseReward()
-    raise ValueError(f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)}")
+    modes = {"schedule": ScheduleReward, "distance": DistanceReward, "sparse": SparseReward}
+    if mode not in modes:
+        raise ValueError(f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)}")
+    return modes[mode]()
