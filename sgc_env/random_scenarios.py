@@ -199,7 +199,10 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
 
     where ``j(theta) = (theta e^theta - e^theta + 1) / theta^2`` bounds the rate of ``J_l``
     (its series, term by term). Without an orientation track ``omega`` is the constant
-    initial one.
+    initial one. Torque actions act about scaled body axes: the action about principal axis k
+    is ``(I_k alpha_k + gyro_k) / (torque_limit I_k / I_max)`` and ``|gyro_k| <= I_k |omega|^2``
+    (principal moments obey ``I_k >= |I_j - I_l|``), so a torque bound below ``torque_limit``
+    keeps every axis of the scaled action below 1.
     """
     from sgc_env.paper.plan import BodyState, OrientationGoal, PlanOptions, PositionGoal, plan_body
 

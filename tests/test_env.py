@@ -155,6 +155,30 @@ def test_force_acts_at_centre_of_mass_without_spin():
     assert np.max(np.abs(info["body_angular_velocity"])) < 1e-12
 
 
+@pytest.mark.parametrize("shape", ["rod", "box"])
+def test_unit_torque_action_gives_the_same_angular_acceleration_about_every_body_axis(shape):
+    tilt = (0.2, -0.4, 0.3, 0.8)
+    tilt = tuple(np.divide(tilt, np.linalg.norm(tilt)))
+    body = Body(
+        "b", shape=shape, size=(0.6, 0.03) if shape == "rod" else (0.3, 0.1, 0.02),
+        position=(0.0, 0.0, 1.0), orientation=tilt, goals=(Goal(nail=(1.0, 0.0, 1.0), time=1.0),),
+    )  # fmt: skip
+    env = SGCEnv(Scenario(bodies=(body,), gravity=(0.0, 0.0, 0.0), margin=0.0))
+    inertia = env.body_inertia[0]
+    assert env.torque_scale[0] == pytest.approx(body.torque_limit * inertia / inertia.max())
+    rm = np.array(sgc_env.simulator.pybullet.getMatrixFromQuaternion(tilt)).reshape(3, 3)
+    for axis in range(3):
+        env.reset()
+        action = np.zeros(6)
+        action[3 + axis] = -1.0
+        _, _, _, _, info = env.step(action)
+        omega_body = rm.T @ info["body_angular_velocity"][0]
+        # one substep's rotation changes the axes a little; the first tick is the same for all
+        expected = -body.torque_limit / inertia.max() * env.dt
+        assert omega_body[axis] == pytest.approx(expected, rel=2e-2), (axis, omega_body)
+        assert info["torque"][0] == pytest.approx(rm[:, axis] * -env.torque_scale[0][axis])
+
+
 def test_gravity_is_on_by_default_and_not_compensated():
     s = load_scenario("point_three_goals")
     env = SGCEnv(s)
@@ -354,6 +378,25 @@ def test_goal_env_compute_reward_is_vectorised():
     assert env.compute_reward(a, d, [{}, {}]).tolist() == [0.0, -1.0]
 
 
+def test_goal_env_charges_the_steps_a_failure_leaves():
+    env = gym.make("SGCPointGoal-v0")
+    env.reset(seed=0)
+    base = env.unwrapped
+    terminated = False
+    while not terminated:
+        obs, reward, terminated, truncated, info = env.step(np.ones(3))
+        assert not truncated
+    left = base.max_steps - base._tick
+    assert left > 0 and info["failure_charge"] == left
+    assert reward == -1.0 - left
+    # HER recomputes rewards with the stored infos: the charge survives relabelling
+    goal = obs["achieved_goal"][None]
+    relabelled = base.compute_reward(goal, goal, [info])
+    assert relabelled.tolist() == [-float(left)]
+    with pytest.raises(ValueError, match="reward modes apply to SGCEnv"):
+        gym.make("SGCPointGoal-v0", reward="sparse")
+
+
 def test_goal_env_with_her():
     from stable_baselines3 import SAC, HerReplayBuffer
 
@@ -383,7 +426,7 @@ def test_close_disconnects():
 
 
 def test_spin_clamp_is_flagged_not_terminal():
-    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), shape="rod"))
+    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 99.5), shape="rod"))
     env.reset()
     _, _, terminated, _, info = env.step(np.array([0, 0, 0, 0, 0, 1], np.float32))
     assert info["spin_clamped"] and not terminated
