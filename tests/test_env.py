@@ -414,7 +414,11 @@ def test_goal_env_with_her():
     desired = batch.observations["desired_goal"].numpy()
     expected = env.unwrapped.compute_reward(achieved, desired, [{}] * len(desired))
     rewards = batch.rewards.numpy().ravel()
-    np.testing.assert_array_equal(rewards, expected)
+    # A failure's transition also carries the charge for the steps it left (its stored info's
+    # failure_charge, which the empty infos here do not have); those are terminal.
+    charged = rewards < -1.0
+    np.testing.assert_array_equal(rewards[~charged], expected[~charged])
+    assert (batch.dones.numpy().ravel()[charged] == 1.0).all()
     assert model.num_timesteps == 330 and (rewards == 0.0).any() and (rewards == -1.0).any()
 
 
@@ -426,7 +430,7 @@ def test_close_disconnects():
 
 
 def test_spin_clamp_is_flagged_not_terminal():
-    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 99.5), shape="rod"))
+    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 98.9), shape="rod"))
     env.reset()
     _, _, terminated, _, info = env.step(np.array([0, 0, 0, 0, 0, 1], np.float32))
     assert info["spin_clamped"] and not terminated
@@ -459,8 +463,8 @@ def test_one_env_id_check_names_the_field_and_the_ids():
 
 def test_dense_reward_is_its_documented_formula():
     """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
-    current course's start deviations, floored at 0.1 m and 0.5 rad)."""
-    env = gym.make("SGCRod-v0")
+    current course's start deviations, floored at 0.1 m and 0.5 rad): the "distance" mode."""
+    env = gym.make("SGCRod-v0", reward="distance")
     obs, _ = env.reset(seed=3)
     lay = env.unwrapped.layout
     rng = np.random.default_rng(0)
