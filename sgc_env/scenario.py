@@ -19,6 +19,7 @@ import numpy as np
 import yaml
 
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
 from sgc_env.paper.routing import resolve_goal_times
 
 __all__ = [
@@ -148,6 +149,7 @@ class Scenario:
     margin: float = 0.25
     control_frequency: int = 60
     time_grid: str = "reject"
+    end_velocity_rule: str = DEFAULT_END_RULE
     resolved: bool = field(default=False, compare=False)
 
     def body_index(self, name: str) -> int:
@@ -381,7 +383,7 @@ _BODY_KEYS = {
 _PROP_KEYS = {"name", "shape", "size", "color", "position", "velocity", "waypoints", "collisions"}
 _SCENARIO_KEYS = {
     "name", "bodies", "props", "goals", "gravity", "workspace", "margin", "control_frequency",
-    "time_grid",
+    "time_grid", "end_velocity_rule",
 }  # fmt: skip
 
 
@@ -511,8 +513,9 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
         if isinstance(cf, bool) or not isinstance(cf, int) or cf <= 0:
             raise _fail("control_frequency", f"expected a positive integer (Hz), got {cf!r}")
         kw["control_frequency"] = cf
-    if "time_grid" in d:
-        kw["time_grid"] = d["time_grid"]
+    for key in ("time_grid", "end_velocity_rule"):
+        if key in d:
+            kw[key] = d[key]
     return Scenario(**kw)
 
 
@@ -524,6 +527,10 @@ def _validate_structure(s: Scenario) -> None:
         raise _fail("bodies", "expected at least one body")
     if s.time_grid not in TIME_GRID_MODES:
         raise _fail("time_grid", f"expected one of {TIME_GRID_MODES}, got {s.time_grid!r}")
+    if s.end_velocity_rule not in END_RULES:
+        raise _fail(
+            "end_velocity_rule", f"expected one of {END_RULES}, got {s.end_velocity_rule!r}"
+        )
     if not (isinstance(s.control_frequency, int) and s.control_frequency > 0):
         raise _fail(
             "control_frequency", f"expected a positive integer, got {s.control_frequency!r}"
