@@ -22,6 +22,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--no-video", action="store_true", help="skip rendering (scorecard and plots only)"
     )
+    parser.add_argument(
+        "--paper-rule", action="store_true",
+        help="end interior courses by the paper's k rules (eqs. 12-14) instead of the tangent "
+        "rule",
+    )  # fmt: skip
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,8 +38,9 @@ def run(args: argparse.Namespace) -> int:
 
     console = Console()
     options = DemoOptions(
-        out=args.out, width=args.width, height=args.height, video=not args.no_video
-    )
+        out=args.out, width=args.width, height=args.height, video=not args.no_video,
+        end_rule="paper" if args.paper_rule else "tangent",
+    )  # fmt: skip
     started = time.perf_counter()
     with Progress(
         TextColumn("three rods"), BarColumn(), TextColumn("{task.completed}/{task.total} ticks"),
@@ -44,7 +50,8 @@ def run(args: argparse.Namespace) -> int:
         result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
     elapsed = time.perf_counter() - started
 
-    table = Table(title="three-rod demo: the expert, scored by the harness")
+    rule = "the paper's k rules" if args.paper_rule else "the tangent rule"
+    table = Table(title=f"three-rod demo: the expert ({rule}), scored by the harness")
     table.add_column("rod", no_wrap=True)
     for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
                    "SPARC", "min speed at goals / avg"):  # fmt: skip
@@ -60,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
     summary = result.summary
     console.print(
         f"{summary['goals_met']}/{summary['n_goals']} goals met, terminated: "
-        f"{bool(summary['terminated'])}, {elapsed:.1f} s wall clock"
+        f"{bool(summary['terminated'])}, {result.cpu_s:.1f} s CPU (this process and ffmpeg), "
+        f"{elapsed:.1f} s wall clock"
     )
     console.print(f"outputs in {args.out}/:")
     for path in sorted(result.files.values()):
