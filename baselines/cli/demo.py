@@ -26,7 +26,7 @@ from baselines.cli.demo_camera import camera_at
 from baselines.cli.demo_view import Caster, DemoPainter, Trail
 from sgc_env.simulator import Simulator, pybullet
 
-__all__ = ["DemoOptions", "DemoResult", "cpu_seconds", "run_demo"]
+__all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
 
 ENV_ID = "SGCThreeRods-v0"
 PLATES = 8
@@ -75,7 +75,7 @@ def cpu_seconds() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
-class _Scene:
+class DemoScene:
     """The visual-only dressing: bullseye, thick rod shells, carried balls."""
 
     def __init__(self, sim: Simulator, scenario: Any) -> None:
@@ -173,7 +173,7 @@ def run_demo(
     tip_times: list[float] = []
     scene = painter = None
     if options.video:
-        scene = _Scene(base.sim, scenario)
+        scene = DemoScene(base.sim, scenario)
         nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
         painter = DemoPainter(base.sim.client, [b.color for b in scenario.bodies], nails)
 

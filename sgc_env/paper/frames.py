@@ -39,11 +39,12 @@ rule for that goal (``rule`` reported ``"sgc"``):
 * a hairpin (the next nail is the previous one): the chord has no direction.
 
 The paper's pi/6 assumption is what bounds ``rho`` for eqs. 12-13; the tangent rule does not
-use ``rho``, and the cone of realisable directions is wider (``atan(sqrt2)`` = 54.7 degrees
-between the tangent and ``-D_i(0)``, i.e. turns up to about 110 degrees between equal
-courses). So a turn beyond pi/6 alone does not make it fall back (``within_paper_assumption``
-still reports it): falling back there too measured SGCRod-v0's whole-track SPARC back at the
-paper's (-2.42 against -2.22, seeds 10000-10009).
+use ``rho``, and its cone of realisable directions is wider: between two courses of equal
+speed it is realised up to a turn of about 86 degrees (every component of ``S_i`` keeps at
+least ``k_min`` of its average), where the paper's own rule already needs its ``rho <= 0``
+extension beyond 54.7 degrees. So a turn beyond pi/6 alone does not make it fall back
+(``within_paper_assumption`` still reports it): falling back there too measured SGCRod-v0's
+whole-track SPARC back at the paper's (-2.42 against -2.22, seeds 10000-10009).
 
 A change of pace: where one average speed is more than :data:`PACE_CHANGE` times the other, the
 speed is the next course's average instead of the mean (the paper's choice too: eqs. 12-13 with
