@@ -190,3 +190,17 @@ def test_cameras_look_where_the_shots_say():
 def test_demo_options_are_validated():
     with pytest.raises(ValueError, match="width"):
         DemoOptions(out=sgc_env.__path__[0], width=0)
+
+
+def test_target_board_whole_in_frame_once_the_flight_is_on():
+    """From 2.6 s (the wide shot) to the end, all 8 corners of the board project inside."""
+    from baselines.cli.demo import _box_corners
+
+    scenario = sgc_env.load_scenario("three_rods")
+    board = next(p for p in scenario.props if p.name == "target")
+    corners = _box_corners(board.position, board.size)
+    for t in np.arange(2.6, scenario.last_goal_time + scenario.margin, 1.0 / 30.0):
+        view = camera_at(float(t), 960, 540)
+        px, depth = view.project(corners)
+        assert np.all(depth > 0.0)
+        assert np.all((px >= 0.0) & (px <= [960.0, 540.0])), t

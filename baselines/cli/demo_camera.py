@@ -33,9 +33,9 @@ class Shot:
 
 
 DEMO_SHOTS: tuple[Shot, ...] = (
-    Shot(0.0, (-7.0, 0.0, 3.0), 8.5, -28.0, -12.0),  # the launch: rods meet the red balls
-    Shot(1.6, (-5.5, 0.0, 3.4), 9.5, -20.0, -10.0),
-    Shot(3.2, (0.0, 0.0, 3.8), 13.5, -5.0, -9.0),  # the flight, wide and from the side
+    Shot(0.0, (-7.0, 0.0, 3.0), 9.0, 32.0, -12.0),  # the launch, seen from ahead: board behind
+    Shot(1.3, (-5.5, 0.0, 3.4), 9.5, 22.0, -10.0),  # the red balls pierced
+    Shot(2.6, (0.0, 0.0, 3.8), 14.0, -5.0, -9.0),  # the flight, wide and from the side
     Shot(5.0, (3.0, 0.0, 3.6), 12.5, -20.0, -9.0),
     Shot(6.6, (5.5, 0.0, 3.3), 10.5, -48.0, -9.0),  # the hits, the board's face at an angle
     Shot(8.6, (6.2, 0.0, 3.2), 9.5, -58.0, -8.0),
