@@ -20,10 +20,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 
 from baselines.cli.demo_camera import camera_at
-from baselines.cli.demo_view import Caster, DemoPainter, Trail
+from baselines.cli.demo_view import TRAIL_SECONDS, Caster, DemoPainter, Trail
+from sgc_env.paper.end_rules import END_RULES
 from sgc_env.simulator import Simulator, pybullet
 
 __all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
@@ -55,8 +57,8 @@ class DemoOptions:
             value = getattr(self, name)
             if not isinstance(value, int) or value < 1:
                 raise ValueError(f"{name}: expected a positive integer, got {value!r}")
-        if self.end_rule not in ("tangent", "paper"):
-            raise ValueError(f"end_rule: expected 'tangent' or 'paper', got {self.end_rule!r}")
+        if self.end_rule not in END_RULES:
+            raise ValueError(f"end_rule: expected one of {END_RULES}, got {self.end_rule!r}")
 
 
 @dataclass
@@ -212,8 +214,6 @@ def run_demo(
 
 def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trail]:
     """The last ``TRAIL_SECONDS`` of every tip, one sample per control tick."""
-    from baselines.cli.demo_view import TRAIL_SECONDS
-
     first = int(np.searchsorted(times, now - TRAIL_SECONDS))
     recent = np.stack(tips[first:])
     stamps = np.asarray(times[first:])
@@ -270,7 +270,6 @@ def gif_durations(count: int, fps: float) -> list[int]:
 
 
 def _videos(frames: list[np.ndarray], times: list[float], options: DemoOptions) -> dict[str, Path]:
-    import cv2
     import imageio.v2 as imageio
 
     mp4 = options.out / "three_rods.mp4"
@@ -297,8 +296,6 @@ def _write_gif(path: Path, frames: Sequence[np.ndarray], durations: Sequence[int
 
 def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:
     """Eight frames nearest :data:`PLATE_TIMES`, two rows of four, each titled."""
-    import cv2
-
     h, w = frames[0].shape[:2]
     scale = min(1.0, 480.0 / w)
     tw, th, band = int(w * scale), int(h * scale), 26

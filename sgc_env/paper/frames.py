@@ -77,6 +77,7 @@ __all__ = [
     "C_LOW",
     "END_RULES",
     "K_MIN",
+    "PACE_CHANGE",
     "PAPER_MAX_TURN",
     "EndVelocity",
     "FrameCourse",
@@ -86,6 +87,7 @@ __all__ = [
     "next_deviation",
     "normalized_frame",
     "solve_course_in_frame",
+    "tangent_speed",
     "turn_angle",
 ]
 
@@ -220,7 +222,9 @@ def choose_k(
 class EndVelocity(NamedTuple):
     """Diagnostics of :func:`course_end_velocity`.
 
-    ``rule``: ``"sgc"`` (eqs. 12-13), ``"last"`` (no next course: user or average velocity),
+    ``rule``: ``"sgc"`` (eqs. 12-13, also where the tangent rule falls back), ``"tangent"``
+    (the chord through the neighbouring nails), ``"last"`` (no next course: user or average
+    velocity),
     ``"rest"`` (arrive at rest: the next course is a dwell, or a zero end velocity was asked
     for) or ``"dwell"`` (this course is one). ``within_paper_assumption`` is False when the
     turn exceeds ``pi/6``, some ``rho <= 0``, or a user end velocity was clamped. ``frame``
