@@ -289,7 +289,11 @@ def _write_gif(path: Path, frames: Sequence[np.ndarray], durations: Sequence[int
     """Pillow GIF with a fast octree palette per frame (median cut costs ~3x the CPU)."""
     from PIL import Image
 
-    images = [Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE) for f in frames]
+    images = [
+        Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
+                                    dither=Image.Dither.FLOYDSTEINBERG)
+        for f in frames
+    ]  # fmt: skip
     images[0].save(path, save_all=True, append_images=images[1:], duration=list(durations),
                    loop=0, optimize=False)  # fmt: skip
 
