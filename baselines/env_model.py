@@ -14,6 +14,7 @@ import numpy as np
 
 from sgc_env.observation import ObservationLayout
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE
 
 __all__ = ["BodyModel", "EnvModel"]
 
@@ -40,6 +41,8 @@ class EnvModel:
     sim_dt: float
     substeps: int
     use_torque: bool
+    end_rule: str = DEFAULT_END_RULE
+    """The scenario's ``end_velocity_rule``: how a planner ends an interior course."""
 
     @property
     def control_dt(self) -> float:
@@ -69,6 +72,7 @@ class EnvModel:
             sim_dt=1.0 / float(base.sim_frequency),
             substeps=int(base.substeps),
             use_torque=bool(base.use_torque),
+            end_rule=scenario.end_velocity_rule,
         )
 
     def action_from_wrenches(self, forces, torques, orientations) -> np.ndarray:

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
 from sgc_env.paper.frames import (
     C_HIGH,
     C_LOW,
@@ -111,12 +112,14 @@ class OrientationGoal:
 
 @dataclass(frozen=True)
 class PlanOptions:
-    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there) and the
-    control grid split somersaults are timed on."""
+    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there), the
+    end-velocity rule of interior goals (``"tangent"``, the default, or ``"paper"``: eqs.
+    12-14) and the control grid split somersaults are timed on."""
 
     c_low: float = C_LOW
     c_high: float = C_HIGH
     k_min: float = K_MIN
+    end_rule: str = DEFAULT_END_RULE
     control_frequency: int | None = None
     """Time a split somersault's sub-courses on this control grid, as the env does (None:
     evenly in continuous time)."""
@@ -132,6 +135,10 @@ class PlanOptions:
             raise ValueError(f"options: c_high must be in (0, 1) (eq. 13), got {self.c_high!r}")
         if not 0.0 < self.k_min <= 1.0:
             raise ValueError(f"options: k_min must be in (0, 1], got {self.k_min!r}")
+        if self.end_rule not in END_RULES:
+            raise ValueError(
+                f"options: end_rule must be one of {list(END_RULES)}, got {self.end_rule!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -355,7 +362,7 @@ def _plan_orientation(
         v_end, info = course_end_velocity(
             phi0, nxt, T, None if last else ends[i + 1] - ends[i],
             end_velocity=end_w if last else None,
-            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min,
+            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min, rule=opts.end_rule,
         )  # fmt: skip
         course = _solve_in_frame(info.frame, phi0, phi_dot, T, v_end)
         courses.append(course)
@@ -424,6 +431,7 @@ def _plan_position(
             c_low=opts.c_low,
             c_high=opts.c_high,
             k_min=opts.k_min,
+            rule=opts.end_rule,
         )
         course = _solve_in_frame(info.frame, d0, dv0, T, v_end)
         courses.append(course)

@@ -42,6 +42,7 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("speed_minima_mean", "speed minima / ep", ".1f"),
     ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
     ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
+    ("force_peak_max", "peak force (N)", ".1f"),
     ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
     ("terminated", "terminated", "d"),
 )
@@ -50,7 +51,8 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--policy", action="append", metavar="SPEC",
-        help="expert | dynamic-constraints | minimum-jerk | random | path to an SB3 .zip; "
+        help="expert | expert-paper | dynamic-constraints | minimum-jerk | random | path to an "
+        "SB3 .zip; "
         "repeat or comma-separate for a comparison (default: expert)",
     )  # fmt: skip
     parser.add_argument(
