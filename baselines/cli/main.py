@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import sys
 from collections.abc import Sequence
 
 __all__ = ["COMMANDS", "build_parser", "main"]
@@ -18,6 +19,7 @@ COMMANDS: dict[str, str] = {
     "demos": "record seeded expert demonstrations to an npz file",
     "evaluate": "score policies on envs with the shared harness: tables, CSV, JSON, plots",
     "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
+    "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
 }
 
 
@@ -35,7 +37,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    words = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser().parse_args(words)
+    args.argv = words  # for commands that record how they were called
     return int(args._module.run(args) or 0)
 
 
