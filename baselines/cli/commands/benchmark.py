@@ -70,6 +70,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cpus-per-run", type=float, default=1.0, help="ray: CPUs per task")
     parser.add_argument("--retry-failed", action="store_true", help="rerun runs that failed")
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    parser.add_argument(
+        "--report-only", action="store_true",
+        help="run nothing: write the leaderboard from the runs finished so far",
+    )  # fmt: skip
 
 
 def _split(values: list[str] | None) -> list[str]:
@@ -158,6 +162,8 @@ def run(args: argparse.Namespace) -> int:
                      and (s.folder(root) / FAILED_FILE).is_file()]  # fmt: skip
     todo = [s for s in grid if s not in finished
             and (args.retry_failed or s not in failed_before)]  # fmt: skip
+    if args.report_only:
+        todo = []
     print(f"{len(grid)} runs: {len(finished)} finished before, {len(failed_before)} failed "
           f"before{' (retrying)' if args.retry_failed else ' (skipped; --retry-failed)'}, "
           f"{len(todo)} to run on {backend.description}", flush=True)  # fmt: skip
@@ -167,7 +173,9 @@ def run(args: argparse.Namespace) -> int:
     failed = [_read(s.folder(root) / FAILED_FILE) for s in grid
               if (s.folder(root) / FAILED_FILE).is_file()]  # fmt: skip
     meta = {
-        "command": shlex.join(["sgc", *getattr(args, "argv", ["benchmark", "..."])]),
+        "command": shlex.join(
+            ["sgc", *(w for w in getattr(args, "argv", ["benchmark"]) if w != "--report-only")]
+        ),
         "eval_episodes": args.eval_episodes, "test_seed": args.test_seed,
         "eval_seed": args.eval_seed, "runs": len(grid), "finished": len(results),
         "failed": len(failed),
