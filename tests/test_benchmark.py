@@ -169,6 +169,26 @@ def test_cli_reports_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixture
     assert "--address is for --backend ray" in capsys.readouterr().err
 
 
+def test_a_lost_worker_is_a_failed_run_and_the_grid_goes_on() -> None:
+    from baselines.benchmark.backends import _throttled
+
+    def collect(handle: dict) -> dict:
+        if handle["run_id"] == "b":
+            raise RuntimeError("worker died")
+        return {"run_id": handle["run_id"], "status": "finished"}
+
+    started: list[str] = []
+    specs = [{"run_id": name} for name in "abc"]
+    outcomes = list(_throttled(specs, 2, dict, lambda p: (p[:1], p[1:]), collect, started.append))
+    assert started == ["a", "b", "c"]
+    assert [(o["run_id"], o["status"]) for o in outcomes] == [
+        ("a", "finished"),
+        ("b", "failed"),
+        ("c", "finished"),
+    ]
+    assert "worker died" in outcomes[1]["error"]
+
+
 # ---------------------------------------------------------------- end to end
 
 

@@ -26,20 +26,35 @@ def _throttled(
     specs: Sequence[dict[str, Any]],
     capacity: int,
     submit: Callable[[dict[str, Any]], Any],
-    finished: Callable[[list[Any]], tuple[list[dict[str, Any]], list[Any]]],
+    wait_some: Callable[[list[Any]], tuple[list[Any], list[Any]]],
+    collect: Callable[[Any], dict[str, Any]],
     on_start: Started | None,
 ) -> Iterator[dict[str, Any]]:
-    """Keep at most ``capacity`` runs in flight (so "running" means running), yield outcomes."""
+    """Keep at most ``capacity`` runs in flight (so "running" means running), yield outcomes.
+
+    A run whose worker dies (killed, out of memory) comes back as a failed outcome, like a
+    run that raised, so that the grid goes on and records it.
+    """
     queue = list(specs)
+    owners: dict[int, dict[str, Any]] = {}
     pending: list[Any] = []
     while queue or pending:
         while queue and len(pending) < capacity:
             spec = queue.pop(0)
-            pending.append(submit(spec))
             if on_start is not None:
                 on_start(spec["run_id"])
-        outcomes, pending = finished(pending)
-        yield from outcomes
+            handle = submit(spec)
+            owners[id(handle)] = spec
+            pending.append(handle)
+        done, pending = wait_some(pending)
+        for handle in done:
+            spec = owners.pop(id(handle))
+            try:
+                yield collect(handle)
+            except Exception as exc:  # noqa: BLE001 - the worker itself was lost
+                yield {"run_id": spec["run_id"], "spec": spec, "status": "failed",
+                       "error": f"worker lost: {type(exc).__name__}: {exc}",
+                       "traceback": "", "wall_time_s": 0.0}  # fmt: skip
 
 
 class LocalBackend:
@@ -62,19 +77,20 @@ class LocalBackend:
         if not specs:
             return
         if self.workers == 1:  # one at a time: in this process, no start-up cost
-            yield from _throttled(specs, 1, execute_run, lambda done: (list(done), []),
-                                  on_start)  # fmt: skip
+            yield from _throttled(
+                specs, 1, execute_run, lambda pending: (pending, []), lambda out: out, on_start
+            )
             return
         context = multiprocessing.get_context("spawn")  # no forked torch/PyBullet state
         with ProcessPoolExecutor(min(self.workers, len(specs)), mp_context=context) as pool:
 
-            def finished(pending: list[Any]) -> tuple[list[Any], list[Any]]:
+            def wait_some(pending: list[Any]) -> tuple[list[Any], list[Any]]:
                 done, rest = wait(pending, return_when=FIRST_COMPLETED)
-                return [f.result() for f in done], list(rest)
+                return list(done), list(rest)
 
             yield from _throttled(
-                specs, self.workers, lambda spec: pool.submit(execute_run, spec), finished,
-                on_start,
+                specs, self.workers, lambda spec: pool.submit(execute_run, spec), wait_some,
+                lambda future: future.result(), on_start,
             )  # fmt: skip
 
 
@@ -128,11 +144,10 @@ class RayBackend:
             cpus = float(self.ray.cluster_resources().get("CPU", 1.0))
             capacity = max(int(cpus // self.cpus_per_run), 1)
 
-            def finished(pending: list[Any]) -> tuple[list[Any], list[Any]]:
-                done, rest = self.ray.wait(pending, num_returns=1)
-                return [self.ray.get(ref) for ref in done], rest
+            def wait_some(pending: list[Any]) -> tuple[list[Any], list[Any]]:
+                return self.ray.wait(pending, num_returns=1)
 
-            yield from _throttled(specs, capacity, task.remote, finished, on_start)
+            yield from _throttled(specs, capacity, task.remote, wait_some, self.ray.get, on_start)
         finally:
             if started_here:
                 self.ray.shutdown()
