@@ -9,10 +9,10 @@ Needs a venv with both (SBX is not a project dependency)::
 
 Each library trains PPO and SAC on SGCPoint-v0 with the hyperparameters of
 hyperparams/{ppo,sac}.yml (256-256 networks; PPO 4 envs x 512 steps, 10 epochs, batch 256;
-SAC one gradient step of batch 256 per env step). Every measurement follows a short warm-up
-run of the same model class (JIT compilation, allocator), and the libraries alternate
-(``--repeats``), so both see the same machine load. Printed: env steps per second of
-``learn`` and the SBX/SB3 ratio. Both use one CPU thread (torch.set_num_threads(1); XLA
+SAC one gradient step of batch 256 per env step, from step 100). Every measurement follows
+a short warm-up run of the same model (JIT compilation, allocator), and the libraries
+alternate (``--repeats``), so both see the same machine load. Printed: env steps per second
+of ``learn`` and the SBX/SB3 ratio. Both use one CPU thread (torch.set_num_threads(1); XLA
 with its Eigen thread pool off), as the benchmark runs one run per core.
 """
 
@@ -43,6 +43,8 @@ def _model(lib: str, algo: str, seed: int):
     hp = load_hyperparams(algo, ENV_ID)
     kwargs = dict(hp.algo_kwargs)
     policy_kwargs = dict(kwargs.pop("policy_kwargs", {}) or {})
+    if algo == "sac":  # gradient steps from the start: the warm-up compiles them
+        kwargs["learning_starts"] = 100
     cls = getattr(sb3 if lib == "sb3" else sbx, algo.upper())
     env = make_vec_env(ENV_ID, n_envs=hp.n_envs, seed=seed)
     return cls(hp.policy, env, seed=seed, policy_kwargs=policy_kwargs, verbose=0, **kwargs)
