@@ -179,12 +179,16 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 def vecnormalize_path(model_path: str | Path) -> Path | None:
     """The ``VecNormalize`` statistics saved with a model by ``sgc train``, if there are any.
 
-    ``final_model.zip``/``best_model.zip`` pair with ``vecnormalize.pkl`` in the same folder;
-    a checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
+    ``<stem>.zip`` pairs with ``<stem>.vecnormalize.pkl`` beside it (shipped models) or else
+    ``vecnormalize.pkl`` in the same folder (``final_model.zip``/``best_model.zip``); a
+    checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
     (SB3's ``CheckpointCallback`` names).
     """
     path = Path(model_path)
     checkpoint = re.fullmatch(r"(.*)_(\d+)_steps", path.stem)
+    own = path.with_name(f"{path.stem}.vecnormalize.pkl")
+    if own.is_file():
+        return own
     if checkpoint:
         stats = path.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps.pkl")
     else:

@@ -21,6 +21,7 @@ COMMANDS: dict[str, str] = {
     "demos": "record seeded expert demonstrations to an npz file",
     "evaluate": "score policies on envs with the shared harness: tables, CSV, JSON, plots",
     "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
+    "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
 }
 
 
@@ -38,10 +39,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    words = list(sys.argv[1:] if argv is None else argv)
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser().parse_args(words)
     except SystemExit as exc:  # argparse: --help (0), or a bad argument reported in one line (2)
         return int(exc.code or 0)
+    args.argv = words  # for commands that record how they were called
     try:
         return int(args._module.run(args) or 0)
     except UsageError as exc:  # a bad argument found before any work; real bugs still raise
