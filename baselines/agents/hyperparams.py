@@ -142,7 +142,7 @@ def _algo_class(algo: str):
 
 
 def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
-    """Read ``<directory>/<algo>.yml`` (default: the packaged one) and resolve ``env_id``'s entry."""
+    """Read ``<directory>/<algo>.yml`` (default: the packaged file) and resolve ``env_id``."""
     algo_cls = _algo_class(algo)
     path = Path(directory) / f"{algo}.yml" if directory else hyperparams_file(algo)
     if not path.is_file():

@@ -45,8 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dagger-episodes", type=int, default=20, help="rollouts per DAgger round")
     add_push_arguments(parser)
     parser.add_argument(
-        "--hyperparams", default=None, help="folder of <algo>.yml (default: the packaged baselines/hyperparams/)"
-    )
+        "--hyperparams", default=None,
+        help="folder of <algo>.yml (default: the packaged baselines/hyperparams/)",
+    )  # fmt: skip
     parser.add_argument("--env-kwargs", default=None, help="JSON dict passed to gym.make")
     parser.add_argument("--device", default="cpu")
     parser.add_argument("--verbose", type=int, default=0)
