@@ -1,12 +1,15 @@
 """sgc_env: Gymnasium environments for sequential-goal constraints (Liu, Ko & Chang 1993).
 
-Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium.
+Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium, each with the
+``max_episode_steps`` of its episodes (:mod:`sgc_env.episode_steps`).
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
+from gymnasium.envs.registration import WrapperSpec
 
+from sgc_env.episode_steps import registered_steps
 from sgc_env.observation import ObservationLayout
 from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_scenario
 
@@ -22,15 +25,25 @@ __all__ = [
 ]
 
 _ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
+_GOAL = "sgc_env.envs.goal_env"
 _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
     "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
-    "SGCPointGoal-v0": ("sgc_env.envs.goal_env:SGCGoalEnv", {"random_scenario": "point"}),
+    "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
-        gym.register(id=_id, entry_point=_entry, kwargs=_kwargs)
+        goal = _entry.startswith(_GOAL)
+        gym.register(
+            id=_id,
+            entry_point=_entry,
+            kwargs=_kwargs,
+            max_episode_steps=registered_steps(_kwargs),
+            additional_wrappers=(
+                (WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {}),) if goal else ()
+            ),
+        )

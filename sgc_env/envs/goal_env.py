@@ -24,7 +24,7 @@ import numpy as np
 
 from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
 
-__all__ = ["SGCGoalEnv"]
+__all__ = ["GoalRewardAccess", "SGCGoalEnv"]
 
 
 class SGCGoalEnv(SGCEnv):
@@ -91,3 +91,22 @@ class SGCGoalEnv(SGCEnv):
         dist = np.linalg.norm(a[..., :3] - d[..., :3], axis=-1)
         on_time = np.abs(a[..., 3] - d[..., 3]) < 0.5 * self.dt
         return np.where((dist <= self.tolerance) & on_time, 0.0, -1.0).astype(np.float32)
+
+
+class GoalRewardAccess(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Outermost wrapper of the registered goal id: exposes ``compute_reward``.
+
+    Gymnasium's wrappers (``TimeLimit``, ``OrderEnforcing``) do not forward attributes, and
+    SB3's ``check_env`` (like other GoalEnv tools) calls ``env.compute_reward`` on the env it
+    is given. The registry adds this wrapper after ``TimeLimit``.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.Wrapper.__init__(self, env)
+
+    def compute_reward(
+        self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any
+    ) -> np.ndarray:
+        """The base env's :meth:`SGCGoalEnv.compute_reward`."""
+        return self.env.unwrapped.compute_reward(achieved_goal, desired_goal, info)  # type: ignore[attr-defined]

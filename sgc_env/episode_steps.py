@@ -1,0 +1,63 @@
+"""How many control steps an episode lasts: the ``max_episode_steps`` each registered id declares.
+
+The env truncates by itself at the last goal's tick plus ``scenario.margin``; the registry's
+bound lets tools that read the spec (``TimeLimit``, ``TimeAwareObservation``, rl-zoo3) know
+it. A built-in scenario's bound equals the env's own (both truncate on the same step); a
+random-scenario id's bound covers every draw of its preset, so its TimeLimit never cuts an
+episode short of the env's own truncation.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from typing import Any
+
+import yaml
+
+from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig
+from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
+
+__all__ = ["random_steps_bound", "registered_steps", "scenario_steps"]
+
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def scenario_steps(scenario: Scenario) -> int:
+    """Steps of an episode of ``scenario``: its last goal's tick plus the margin's ticks.
+
+    The same count as ``SGCEnv.max_steps``. An unresolved scenario is resolved only when a
+    body's last goal has no time of its own (routing places untimed goals before timed ones).
+    """
+    if any(b.goals and b.goals[-1].time is None for b in scenario.bodies):
+        scenario = resolve_scenario(scenario)
+    f = scenario.control_frequency
+    times = [float(g.time) for b in scenario.bodies for g in b.goals if g.time is not None]
+    return max(round(t * f) for t in times) + math.ceil(scenario.margin * f - 1e-9)
+
+
+def random_steps_bound(config: RandomScenarioConfig | str) -> int:
+    """Most steps an episode of a random-scenario preset can last (over every draw).
+
+    Mirrors :func:`~sgc_env.random_scenarios.random_scenario`: a course of length ``L`` is
+    flown at no less than ``min(speed_low, cap)``, where ``cap`` (the speed the force budget
+    allows after a course flown at ``v_prev``) grows with ``L`` slower than ``L`` and falls
+    with ``v_prev``; so ``L / speed`` is largest for the longest course after the fastest one.
+    """
+    cfg = PRESETS[config] if isinstance(config, str) else config
+    f = cfg.control_frequency
+    accel_budget = 0.9 * (cfg.force_limit / cfg.mass - 9.81)
+    length, v_prev = cfg.spacing[1], cfg.speed[1]
+    cap = 0.5 * (-v_prev + math.sqrt(v_prev**2 + 4 * accel_budget * length / _ACCEL_FACTOR))
+    slowest = min(cfg.speed[0], cap)
+    course = max(6, math.ceil(length / slowest * f + 1e-6))
+    return cfg.n_goals[1] * course + math.ceil(cfg.margin * f - 1e-9)
+
+
+def registered_steps(kwargs: dict[str, Any]) -> int:
+    """``max_episode_steps`` for an id registered with these ``SGCEnv`` keyword arguments."""
+    if kwargs.get("random_scenario") is not None:
+        return random_steps_bound(kwargs["random_scenario"])
+    name = kwargs["scenario"]
+    text = (resources.files("sgc_env") / "scenarios" / f"{name}.yaml").read_text()
+    return scenario_steps(scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name))
