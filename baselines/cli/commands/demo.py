@@ -25,11 +25,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import gymnasium as gym
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
     from rich.table import Table
 
-    from baselines.cli.demo import DemoOptions, run_demo
+    import sgc_env  # noqa: F401  (registers the ids)
+    from baselines.cli.demo import ENV_ID, DemoOptions, run_demo
 
     console = Console()
     options = DemoOptions(
@@ -40,7 +42,8 @@ def run(args: argparse.Namespace) -> int:
         TextColumn("three rods"), BarColumn(), TextColumn("{task.completed}/{task.total} ticks"),
         TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
-        task = bar.add_task("demo", total=None)
+        # the registry's episode length is the demo's tick count, known before the env is built
+        task = bar.add_task("demo", total=gym.spec(ENV_ID).max_episode_steps)
         result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
     elapsed = time.perf_counter() - started
 

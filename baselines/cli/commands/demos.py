@@ -44,7 +44,7 @@ def parse_env_kwargs(text: str | None) -> dict[str, Any]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--env", required=True, help="registered id with a flat observation")
-    parser.add_argument("--episodes", type=int, required=True)
+    parser.add_argument("--episodes", type=int, required=True, help="how many episodes")
     parser.add_argument("--seed", type=int, default=0, help="episodes use seed, seed+1, ...")
     parser.add_argument("--out", required=True, help="output .npz, or the Minari dataset id")
     parser.add_argument(
