@@ -130,7 +130,7 @@ def run_episode(
     tolerances: Tolerances | None = None,
     keep_infos: bool = False,
     max_steps: int = 100_000,
-    frames: list[np.ndarray] | None = None,
+    frames: list[Any] | None = None,
     on_step: Callable[[gym.Env, int, Mapping[str, Any]], None] | None = None,
 ) -> EpisodeRecord:
     """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
@@ -162,7 +162,7 @@ def run_episode(
             on_step(env, len(infos), info)
         if terminated or truncated:
             break
-    base = env.unwrapped
+    base: Any = env.unwrapped
     goals = goals_from_scenario(base.scenario)
     card = score_episode(infos, goals, base.dt, tolerances, initial_info=initial_info)
     return EpisodeRecord(

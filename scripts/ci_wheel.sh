@@ -8,8 +8,10 @@ root="$PWD"
 work="$(mktemp -d "${TMPDIR:-/tmp}/sgc-wheel.XXXXXX")"
 trap 'rm -rf "$work"' EXIT
 step() { printf '\n[wheel %s] %s\n' "$(date +%H:%M:%S)" "$*"; }
-step "1/4 build the wheel"
-.venv/bin/python -m pip wheel --no-deps --progress-bar off -w "$work/dist" . >/dev/null
+step "1/4 build the wheel (from a copy of the tracked and unignored files: no build/ left here)"
+mkdir "$work/src"
+git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$work/src"
+.venv/bin/python -m pip wheel --no-deps --progress-bar off -w "$work/dist" "$work/src" >/dev/null
 wheel="$(ls "$work"/dist/sgc-*.whl)"
 unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenarios/three_rods.yaml|ppo_dagger_SGCPoint"
 step "2/4 install $(basename "$wheel")[rl] into a fresh venv"

@@ -90,23 +90,30 @@ def record_minari(
             raise ValueError(
                 f"env: demos need a flat Box observation; {env_id} has {env.observation_space}"
             )
-        n_bodies = len(env.unwrapped.scenario.bodies)
+        base: Any = env.unwrapped
+        n_bodies = len(base.scenario.bodies)
+        action_space = env.action_space
+        assert isinstance(action_space, gym.spaces.Box)  # every SGC id acts with a Box
         policy = make_policy("expert", env)
         buffers = []
         for k in range(episodes):
             obs, info = env.reset(seed=seed + k)
-            observations, actions, infos = [obs], [], [fixed_info(info, n_bodies)]
-            rewards, terminations, truncations = [], [], []
+            observations: list[np.ndarray] = [obs]
+            actions: list[np.ndarray] = []
+            infos = [fixed_info(info, n_bodies)]
+            rewards: list[float] = []
+            terminations: list[bool] = []
+            truncations: list[bool] = []
             done = False
             while not done:
                 action, _ = policy.predict(obs, deterministic=True)
                 obs, reward, terminated, truncated, info = env.step(action)
-                for column, value in (
-                    (observations, obs), (actions, np.asarray(action, np.float64)),
-                    (infos, fixed_info(info, n_bodies)), (rewards, float(reward)),
-                    (terminations, bool(terminated)), (truncations, bool(truncated)),
-                ):  # fmt: skip
-                    column.append(value)
+                observations.append(obs)
+                actions.append(np.asarray(action, np.float64))
+                infos.append(fixed_info(info, n_bodies))
+                rewards.append(float(reward))
+                terminations.append(bool(terminated))
+                truncations.append(bool(truncated))
                 done = terminated or truncated
             buffers.append(
                 EpisodeBuffer(
@@ -120,14 +127,14 @@ def record_minari(
             buffer=buffers,
             env=env,
             eval_env=env.spec,
-            action_space=float64_action_space(env.action_space),
+            action_space=float64_action_space(action_space),
             algorithm_name="SGCExpert (baselines.policies 'expert')",
             description=(
                 f"{episodes} expert episodes of {env_id} from seed {seed}; actions are the "
                 "float64 the env received; infos: baselines.agents.minari_data.fixed_info"
             ),
             data_format="hdf5",
-            **publisher,  # type: ignore[arg-type]
+            **publisher,
         )
     finally:
         env.close()

@@ -10,7 +10,7 @@ the spirit of the paper's Plates 1-8, deviation plots per rod, ``goals.csv`` and
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -126,15 +126,15 @@ def run_demo(
     options.out.mkdir(parents=True, exist_ok=True)
     camera = {**asdict(DEMO_CAMERA), "width": options.width, "height": options.height}
     env = gym.make(ENV_ID, render_mode="rgb_array", camera=camera)
-    base = env.unwrapped
+    base: Any = env.unwrapped
     target = next(p for p in base.scenario.props if p.name == "target")
     dress_scene(base.sim, target.position, target.size)
     trails = TipTrails(base.sim, [b.color for b in base.scenario.bodies], options.trail_length)
     total = base.max_steps
-    frames: list[np.ndarray] = []
+    frames: list[Any] = []
     frame_times: list[float] = []
 
-    def on_step(env_: Any, step: int, info: dict[str, Any]) -> None:
+    def on_step(env_: Any, step: int, info: Mapping[str, Any]) -> None:
         trails.update(info["point_position"])
         if options.video and step % options.frame_every == 0:
             frames.append(env_.render())
@@ -200,7 +200,7 @@ def _plots(record: Any, out: Path) -> dict[str, Path]:
     }  # fmt: skip
 
 
-def _videos(frames: list[np.ndarray], times: list[float], options: DemoOptions) -> dict[str, Path]:
+def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
     from matplotlib.figure import Figure
 
