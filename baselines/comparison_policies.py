@@ -23,13 +23,15 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.actuation import BodyObservation, read_body, wrench_for_targets
+from baselines.actuation import wrench_for_targets
 from baselines.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.env_model import EnvModel
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.observation_fields import BodyObservation, read_body
 from baselines.vector import base_env, sub_env
 from sgc_env.metrics import goals_from_scenario
 from sgc_env.paper.orientation import left_jacobian_inverse
+from sgc_env.paper.quaternion import unwrap_rotvec
 from sgc_env.scenario import Scenario
 
 __all__ = [
@@ -190,13 +192,7 @@ def _compose(phi: np.ndarray, start: np.ndarray) -> np.ndarray:
     goals, as the observation gives it), R = Exp(phi') R_j.
     """
     principal = (Rotation.from_rotvec(phi) * Rotation.from_rotvec(start)).as_rotvec()
-    reference = phi + start
-    angle = float(np.linalg.norm(principal))
-    if angle < 1e-12:
-        return principal
-    axis = principal / angle
-    turns = round((axis @ reference - angle) / (2.0 * np.pi))
-    return axis * (angle + 2.0 * np.pi * turns)
+    return np.array(unwrap_rotvec(principal, phi + start))
 
 
 class DynamicConstraintsController(_StatefulPolicy):

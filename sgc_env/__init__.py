@@ -15,6 +15,7 @@ from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_sce
 
 __all__ = [
     "ENV_IDS",
+    "check_env_id",
     "Body",
     "Goal",
     "ObservationLayout",
@@ -37,13 +38,21 @@ ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
-        goal = _entry.startswith(_GOAL)
+        _goal = _entry.startswith(_GOAL)
         gym.register(
             id=_id,
             entry_point=_entry,
             kwargs=_kwargs,
             max_episode_steps=registered_steps(_kwargs),
             additional_wrappers=(
-                (WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {}),) if goal else ()
+                (WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {}),) if _goal else ()
             ),
         )
+
+
+def check_env_id(env_id: object, field: str = "env_id") -> str:
+    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
+    SGC ids (the one check of the package, the harness, training and the CLI)."""
+    if not isinstance(env_id, str) or env_id not in gym.registry:
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")
+    return env_id

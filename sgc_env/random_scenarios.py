@@ -178,7 +178,7 @@ def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, 
     Costly (milliseconds), so the env does not call it on every reset; tests use it to show
     that the limits from the geometric bound cover what the plan needs.
     """
-    from sgc_env.paper.plan import BodyState, OrientationGoal, PositionGoal, plan_body
+    from sgc_env.paper.plan import BodyState, OrientationGoal, PlanOptions, PositionGoal, plan_body
 
     g = np.asarray(scenario.gravity, float)
     out = []
@@ -195,6 +195,7 @@ def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, 
                              relative_rotation=None if gl.relative_rotation is None
                              else np.asarray(gl.relative_rotation))
              for gl in b.goals if gl.has_orientation],
+            options=PlanOptions(control_frequency=scenario.control_frequency),
         )  # fmt: skip
         inertia = _inertia_bound(RandomScenarioConfig(shape=b.shape, size=b.size, mass=b.mass))
         t_end = max(float(gl.time) for gl in b.goals)  # type: ignore[arg-type]

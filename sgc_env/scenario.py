@@ -156,12 +156,6 @@ class Scenario:
                 return i
         raise KeyError(f"no body named {name!r}")
 
-    @property
-    def last_goal_time(self) -> float:
-        if not self.resolved:
-            raise ScenarioError("scenario is not resolved: call resolve_scenario first")
-        return max(float(g.time) for b in self.bodies for g in b.goals)  # type: ignore[arg-type]
-
 
 # ---------------------------------------------------------------- point-to-path goals
 

@@ -59,7 +59,7 @@ def _help(command: str, capsys: pytest.CaptureFixture[str]) -> str:
 
 def test_help_shows_defaults(capsys) -> None:
     evaluate = _help("evaluate", capsys)
-    assert "(default: 5)" in evaluate and "(default: 1000)" in evaluate
+    assert "(default: 5)" in evaluate and "(default: 10000)" in evaluate
     assert "(default: None)" not in evaluate and "(default: False)" not in evaluate
     assert "(default: 0.02)" in evaluate
     train = _help("train", capsys)

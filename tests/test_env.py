@@ -13,7 +13,7 @@ from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
-from sgc_env.envs import SGCEnv
+from sgc_env.envs import GoalEvent, SGCEnv, StepInfo
 from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS, float32_residuals
 from sgc_env.scenario import Body, Goal, Scenario, load_scenario
 
@@ -244,6 +244,9 @@ def test_goal_ticks_advance_goals_and_report_errors():
         steps += 1
         events += info.get("goal_reached", [])
         assert not terminated
+        assert set(info) - {"goal_reached"} == StepInfo.__required_keys__
+        assert set(info) - StepInfo.__required_keys__ <= StepInfo.__optional_keys__
+    assert all(set(e) == GoalEvent.__required_keys__ for e in events)
     assert steps == 90 + 15  # last goal at 1.5 s, margin 0.25 s, 60 Hz
     assert [e["goal"] for e in events] == [0, 1, 2]
     assert [round(e["time"] * 60) for e in events] == [30, 58, 90]
@@ -347,6 +350,15 @@ def test_goal_env_with_her():
         policy_kwargs={"net_arch": [16]}, seed=0,
     )  # fmt: skip
     model.learn(330)
+    # HER relabels desired goals with achieved ones; every relabelled reward must be the env's
+    # own compute_reward(next achieved, desired), and relabelling must create successes.
+    batch = model.replay_buffer.sample(2000)
+    achieved = batch.next_observations["achieved_goal"].numpy()
+    desired = batch.observations["desired_goal"].numpy()
+    expected = env.unwrapped.compute_reward(achieved, desired, [{}] * len(desired))
+    rewards = batch.rewards.numpy().ravel()
+    np.testing.assert_array_equal(rewards, expected)
+    assert model.num_timesteps == 330 and (rewards == 0.0).any() and (rewards == -1.0).any()
 
 
 def test_close_disconnects():
@@ -378,3 +390,11 @@ def test_goals_of_every_body_are_reported_when_another_body_is_done():
             (e["body"], e["goal"], round(e["time"] * 60)) for e in info.get("goal_reached", [])
         ]
     assert events == [(1, 0, 15), (0, 0, 30), (1, 1, 60)]
+
+
+def test_one_env_id_check_names_the_field_and_the_ids():
+    assert sgc_env.check_env_id("SGCPoint-v0") == "SGCPoint-v0"
+    with pytest.raises(ValueError, match=r"^env: unknown environment 'Nope-v0'; SGC ids: \['SGCP"):
+        sgc_env.check_env_id("Nope-v0", "env")
+    with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
+        sgc_env.check_env_id(3)

@@ -22,6 +22,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.defaults import POSITION_TOLERANCE
 from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
 
 __all__ = ["GoalRewardAccess", "SGCGoalEnv"]
@@ -30,10 +31,10 @@ __all__ = ["GoalRewardAccess", "SGCGoalEnv"]
 class SGCGoalEnv(SGCEnv):
     """:class:`SGCEnv` with a Dict observation (observation, achieved_goal, desired_goal)."""
 
-    def __init__(self, *args: Any, tolerance: float = 0.02, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, tolerance: float = POSITION_TOLERANCE, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._init_kwargs["tolerance"] = tolerance
-        if self.tracks[0].position is None:
+        if not self.task.has_position[0]:
             raise ValueError("the goal-conditioned env needs a position track on body 0")
         self.tolerance = float(tolerance)
         box = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (4,), np.float32)
@@ -47,13 +48,10 @@ class SGCGoalEnv(SGCEnv):
         )
 
     def _dict_obs(self) -> dict[str, np.ndarray]:
-        tr = self.tracks[0].position
-        k = self._pos_idx[0]
-        t = self._tick * self.dt
         return {
             "observation": self._obs.copy(),
-            "achieved_goal": np.array([*self._point_pos[0], t], dtype=np.float32),
-            "desired_goal": np.array([*tr.targets[k], tr.times[k]], dtype=np.float32),  # type: ignore[union-attr]
+            "achieved_goal": self.task.achieved_goal(0),
+            "desired_goal": self.task.desired_goal(0),
         }
 
     def reset(

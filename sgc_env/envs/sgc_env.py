@@ -80,7 +80,7 @@ import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import gymnasium as gym
 import numpy as np
@@ -90,30 +90,20 @@ from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
-from sgc_env.simulator import Drive, Simulator, pybullet
+from sgc_env.simulator import Drive, Simulator
 
-from .tracks import (
-    BodyTracks,
-    Track,
-    compile_tracks,
-    quat_conj_mul,
-    rotate,
-    rotvec_from_quat,
-    unwrap_rotvec,
-)
+from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction, TaskCounters
 
-__all__ = ["SGCEnv", "SavedState"]
+__all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
 SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
 
-# Offsets inside a body block (see sgc_env.observation.BODY_FIELDS).
-_BLOCK = ObservationLayout(1)
-_DEV = _BLOCK.body_slice(0, "position_deviation").start
 # Per-body columns of the (bodies, block) record that info hands out as views; built once
 # because constructing the index tuples costs as much as the slicing itself.
-_COL_DEV = np.s_[:, _DEV : _DEV + 3]
+_BLOCK = ObservationLayout(1)
+_COL_DEV = np.s_[:, _BLOCK.body_slice(0, "position_deviation")]
 _COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
 _COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
 _COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
@@ -122,8 +112,32 @@ _COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
 _COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
 _COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
 _COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
-_ZERO3 = (0.0, 0.0, 0.0)
-_ZERO6 = (0.0,) * 6
+
+
+class _StepInfoEveryStep(TypedDict):
+    time: float
+    goal_index: np.ndarray
+    orientation_goal_index: np.ndarray
+    position_deviation: np.ndarray
+    orientation_deviation: np.ndarray
+    time_to_goal: np.ndarray
+    orientation_time_to_goal: np.ndarray
+    body_position: np.ndarray
+    body_orientation: np.ndarray
+    body_velocity: np.ndarray
+    body_angular_velocity: np.ndarray
+    point_position: np.ndarray
+    point_velocity: np.ndarray
+    force: np.ndarray
+    torque: np.ndarray
+    spin_clamped: bool
+
+
+class StepInfo(_StepInfoEveryStep, total=False):
+    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
+    one row per body; ``goal_reached`` only on a tick where goals fall."""
+
+    goal_reached: list[GoalEvent]
 
 
 @dataclass(frozen=True)
@@ -132,12 +146,6 @@ class SavedState:
 
     bullet_state: int
     counters: dict[str, Any]
-
-
-def _with(array: np.ndarray, i: int, value: int) -> np.ndarray:
-    out = array.copy()
-    out[i] = value
-    return out
 
 
 def _as_scenario(spec: Scenario | str | Path) -> Scenario:
@@ -149,17 +157,6 @@ def _geometry(s: Scenario) -> tuple:
         tuple((b.name, b.shape, b.size, b.mass, b.color, b.collisions) for b in s.bodies),
         tuple((p.name, p.shape, p.size, p.color, p.collisions) for p in s.props),
     )
-
-
-def _course_fields(track: Track, k: int) -> tuple[float, ...]:
-    """The 13 static observation entries of a track's course ``k``: course start and duration,
-    next start and duration, end velocity (last goal only) and the two flags."""
-    last = k == track.size - 1
-    end = tuple(track.end_velocity) if last else (0.0, 0.0, 0.0)
-    return (
-        *track.course_start[k].tolist(), float(track.durations[k]),
-        *track.next_start[k].tolist(), float(track.next_duration[k]), *end, 1.0, float(last),
-    )  # fmt: skip
 
 
 class SGCEnv(gym.Env):
@@ -239,8 +236,7 @@ class SGCEnv(gym.Env):
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
         self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
-        self._get_pose = pybullet.getBasePositionAndOrientation
-        self._get_velocity = pybullet.getBaseVelocity
+        self._reward: RewardFunction = DistanceReward()
         self._markers: NailMarkers | None = None
         self.scenario: Scenario = base
         self._geometry: tuple = ()
@@ -296,10 +292,7 @@ class SGCEnv(gym.Env):
         self.scenario = s
         self.sim.set_gravity(s.gravity)
         self._gravity = tuple(float(g) for g in s.gravity)
-        self.tracks: list[BodyTracks] = compile_tracks(s)
-        self._has_pos = [bt.position is not None for bt in self.tracks]
-        self._has_ori = [bt.orientation is not None for bt in self.tracks]
-        self._init_caches()
+        self.task = GoalTask(s, self._reward)
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
         self._tlimit = [float(b.torque_limit) for b in s.bodies]
@@ -337,7 +330,7 @@ class SGCEnv(gym.Env):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
+    ) -> tuple[np.ndarray, StepInfo]:
         super().reset(seed=seed)
         options = options or {}
         if options.get("scenario") is not None:
@@ -361,127 +354,40 @@ class SGCEnv(gym.Env):
         self._tick = 0
         self._zeros3n = [0.0] * (3 * self._n)
         self._applied = [0.0] * (6 * self._n)
-        self._pos_idx = [0] * self._n
-        self._ori_idx = [0] * self._n
-        self._phi = [
-            tr.orientation.course_start[0].tolist() if tr.orientation else [0.0] * 3
-            for tr in self.tracks
-        ]
-        for i in range(self._n):
-            self._write_static(i)
+        self.task.reset()
         self._observe()
 
-    def _write_static(self, i: int) -> None:
-        """Cache what changes only when a body's current goal changes (as Python tuples)."""
-        zeros13 = (0.0,) * 13
-        tr = self.tracks[i].position
-        if tr is not None:
-            k = self._pos_idx[i]
-            self._s_offset[i] = tuple(tr.points[k].tolist())
-            self._s_offset_residual[i] = float32_residuals(self._s_offset[i])
-            self._s_nail[i] = tuple(tr.targets[k].tolist())
-            self._s_ptime[i] = float(tr.times[k])
-            self._s_pos[i] = _course_fields(tr, k)
-            self._s_pscale[i] = 1.0 / max(float(np.linalg.norm(tr.course_start[k])), 0.1)
-            self._goal_index = _with(self._goal_index, i, int(tr.goal_ids[k]))
-        else:
-            self._s_offset[i] = (0.0, 0.0, 0.0)
-            self._s_offset_residual[i] = [0.0, 0.0, 0.0]
-            self._s_pos[i] = zeros13
-        to = self.tracks[i].orientation
-        if to is not None:
-            k = self._ori_idx[i]
-            self._s_quat[i] = tuple(to.targets[k].tolist())
-            self._s_otime[i] = float(to.times[k])
-            self._s_ori[i] = _course_fields(to, k)
-            self._s_oscale[i] = 1.0 / max(float(np.linalg.norm(to.course_start[k])), 0.5)
-            self._ori_goal_index = _with(self._ori_goal_index, i, int(to.goal_ids[k]))
-        else:
-            self._s_ori[i] = zeros13
-        self._next_event = self._first_pending_tick()
-
-    def _first_pending_tick(self) -> int:
-        """The earliest goal tick still ahead of the current tick (-1 when none is left)."""
-        ticks = []
-        for j, bt in enumerate(self.tracks):
-            if bt.position is not None:
-                ticks.append(int(bt.position.ticks[self._pos_idx[j]]))
-            if bt.orientation is not None:
-                ticks.append(int(bt.orientation.ticks[self._ori_idx[j]]))
-        ahead = [k for k in ticks if k > self._tick]
-        return min(ahead) if ahead else -1
-
-    def _init_caches(self) -> None:
-        n = self._n
-        self._s_offset: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
-        self._s_offset_residual: list[list[float]] = [[0.0, 0.0, 0.0]] * n
-        self._s_nail: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
-        self._s_quat: list[tuple[float, ...]] = [(0.0, 0.0, 0.0, 1.0)] * n
-        self._s_ptime = [0.0] * n
-        self._s_otime = [0.0] * n
-        self._s_pos: list[tuple[float, ...]] = [()] * n
-        self._s_ori: list[tuple[float, ...]] = [()] * n
-        self._s_pscale = [0.0] * n
-        self._s_oscale = [0.0] * n
-        self._goal_index = np.full(n, -1)
-        self._ori_goal_index = np.full(n, -1)
-
     def _observe(self, read: bool = True) -> None:
-        """Read every body once and build the observation, deviations and failure flags.
+        """Read every body once, let the task measure it, and build the observation.
 
         Pure-Python arithmetic on tuples, one struct pack into a fresh buffer and one cast:
         for a few bodies that is several times cheaper than numpy calls on 3-vectors.
         ``read=False`` rebuilds from the last read (after a goal switch) without calling
-        PyBullet again.
+        PyBullet again. Also sets the failure and spin-clamp flags.
         """
         if read:
-            get_p, get_v, c = self._get_pose, self._get_velocity, self.sim.client
-            self._states = [
-                get_p(uid, physicsClientId=c) + get_v(uid, physicsClientId=c) for uid in self._uids
-            ]
+            self._states = self.sim.body_states(self._uids)
         t = self._tick * self.dt
-        s_offset, s_pos, s_ori = self._s_offset, self._s_pos, self._s_ori
-        has_pos, has_ori, phis = self._has_pos, self._has_ori, self._phi
+        task = self.task
+        task.measure(self._states, t)
+        offsets, residuals = task.offsets, task.offset_residuals
+        devs, phis = task.deviations, task.phi
+        ptls, otls = task.position_time_left, task.orientation_time_left
+        pcourse, ocourse = task.position_course, task.orientation_course
         flat: list[float] = []
-        points = []
-        cost = 0.0
         ok = True
         spin = 0.0
         lo, hi = self._ws_low, self._ws_high
         for i, (pos, orn, lin, ang) in enumerate(self._states):
-            offset = s_offset[i]
-            if offset == _ZERO3:
-                r, p = offset, pos
-            else:
-                r = rotate(orn, offset)
-                p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
-            points.append(p)
-            wx, wy, wz = ang
-            if has_pos[i]:
-                nail = self._s_nail[i]
-                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
-                dev = (
-                    dx, dy, dz, lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
-                    lin[2] + wx * r[1] - wy * r[0],
-                )  # fmt: skip
-                ptl = self._s_ptime[i] - t
-                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * self._s_pscale[i]
-            else:
-                dev, ptl = _ZERO6, 0.0
-            if has_ori[i]:
-                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, self._s_quat[i])), phis[i])
-                phis[i] = phi
-                otl = self._s_otime[i] - t
-                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * self._s_oscale[i]
-            else:
-                phi, otl = _ZERO3, 0.0
+            dev, phi, ptl, otl = devs[i], phis[i], ptls[i], otls[i]
             # The residual slots follow in RESIDUAL_FIELDS order (pinned by a test); the point
             # offset's is cached with the goal.
             flat += [
-                *pos, *orn, *lin, *ang, *offset, *dev, ptl, *s_pos[i], *phi, otl, *s_ori[i],
-                *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
-                *self._s_offset_residual[i],
+                *pos, *orn, *lin, *ang, *offsets[i], *dev, ptl, *pcourse[i], *phi, otl,
+                *ocourse[i], *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
+                *residuals[i],
             ]  # fmt: skip
+            wx, wy, wz = ang
             spin = max(spin, wx * wx + wy * wy + wz * wz)
             if ok:
                 vx, vy, vz = lin
@@ -493,7 +399,7 @@ class SGCEnv(gym.Env):
                     and spin == spin
                 )  # fmt: skip
         flat.append(t)
-        for p in points:
+        for p in task.points:
             flat += p
         flat += self._applied
         # A fresh buffer every step (callers keep old observations and infos); the info
@@ -505,12 +411,10 @@ class SGCEnv(gym.Env):
         self._obs = arr[:size].astype(np.float32)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
-        self._point_pos = points
-        self._cost = cost
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
         if a.shape != self._action_shape:
             raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
@@ -559,8 +463,13 @@ class SGCEnv(gym.Env):
         self._applied = applied_f + (applied_t or self._zeros3n)
         self._tick += 1
         self._observe()
-        events = self._advance_goals() if self._tick >= self._next_event >= 0 else []
-        reward = self._reward(values, events)
+        task = self.task
+        events: list[GoalEvent] = []
+        if self._tick >= task.next_event >= 0:
+            events, changed = task.advance(self._tick)
+            if changed:
+                self._observe(read=False)
+        reward = task.reward(values, events)
         terminated = self._failed
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
@@ -568,68 +477,12 @@ class SGCEnv(gym.Env):
             self.render()
         return self._obs, reward, terminated, truncated, info
 
-    def _advance_goals(self) -> list[dict[str, Any]]:
-        """Record goals whose tick is now, then move the observation to the next goals."""
-        events: list[dict[str, Any]] = []
-        tick = self._tick
-        any_changed = False
-        for i, bt in enumerate(self.tracks):
-            changed = False
-            hits: dict[int, dict[str, Any]] = {}
-            tr, to = bt.position, bt.orientation
-            if tr is not None and tr.ticks[self._pos_idx[i]] == tick:
-                k = self._pos_idx[i]
-                d = self._block[i, _DEV : _DEV + 3]
-                g = int(tr.goal_ids[k])
-                hits[g] = {
-                    "body": i,
-                    "goal": g,
-                    "time": tick * self.dt,
-                    "position_error": float(math.sqrt(d @ d)),
-                    "orientation_error": None,
-                }
-                if k < tr.size - 1:
-                    self._pos_idx[i] = k + 1
-                    changed = True
-            if to is not None and to.ticks[self._ori_idx[i]] == tick:
-                k = self._ori_idx[i]
-                phi = self._phi[i]
-                g = int(to.goal_ids[k])
-                if not to.via[k]:
-                    ev = hits.setdefault(
-                        g, {"body": i, "goal": g, "time": tick * self.dt, "position_error": None}
-                    )
-                    ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
-                if k < to.size - 1:
-                    self._ori_idx[i] = k + 1
-                    start = to.course_start[k + 1]
-                    self._phi[i] = (phi[0] + start[0], phi[1] + start[1], phi[2] + start[2])
-                    changed = True
-            for g in sorted(hits):
-                events.append(hits[g])
-            if changed:
-                self._write_static(i)
-                any_changed = True
-        if any_changed:
-            self._observe(read=False)
-        self._next_event = self._first_pending_tick()
-        return events
-
-    def _reward(self, values: list[float], events: list[dict[str, Any]]) -> float:
-        reward = -self._cost / self._n - 0.01 * sum([x * x for x in values]) / len(values)
-        for ev in events:
-            if ev["position_error"] is not None:
-                reward += math.exp(-ev["position_error"] / 0.01)
-            if ev["orientation_error"] is not None:
-                reward += math.exp(-ev["orientation_error"] / 0.02)
-        return reward
-
-    def _info(self, events: list[dict[str, Any]]) -> dict[str, Any]:
+    def _info(self, events: list[GoalEvent]) -> StepInfo:
         block, tail = self._block, self._tail
-        info: dict[str, Any] = {
+        info: StepInfo = {
             "time": self._tick * self.dt,
-            "goal_index": self._goal_index.copy(),
-            "orientation_goal_index": self._ori_goal_index.copy(),
+            "goal_index": self.task.goal_index.copy(),
+            "orientation_goal_index": self.task.orientation_goal_index.copy(),
             "position_deviation": block[_COL_DEV],
             "orientation_deviation": block[_COL_ODEV],
             "time_to_goal": block[_COL_PTL],
@@ -649,23 +502,14 @@ class SGCEnv(gym.Env):
         return info
 
     def _counters(self) -> dict[str, Any]:
-        return {
-            "tick": self._tick,
-            "pos_idx": list(self._pos_idx),
-            "ori_idx": list(self._ori_idx),
-            "phi": [list(p) for p in self._phi],
-            "scenario": self.scenario,
-        }
+        return {"tick": self._tick, "task": self.task.counters(), "scenario": self.scenario}
 
     def _apply_counters(self, c: dict[str, Any]) -> None:
         if c["scenario"] is not self.scenario:
             self._set_scenario(c["scenario"])
         self._tick = c["tick"]
-        self._pos_idx = list(c["pos_idx"])
-        self._ori_idx = list(c["ori_idx"])
-        self._phi = [list(p) for p in c["phi"]]
-        for i in range(self._n):
-            self._write_static(i)
+        task_counters: TaskCounters = c["task"]
+        self.task.restore(task_counters, self._tick)
 
     def save_state(self) -> SavedState:
         """Snapshot physics (PyBullet saveState, in memory) and the env's goal counters."""
@@ -697,7 +541,7 @@ class SGCEnv(gym.Env):
         if dp.shape != (3,) or dl.shape != (3,) or not np.all(np.isfinite([*dp, *dl])):
             raise ValueError(f"impulse must be two finite 3-vectors, got {linear!r}, {angular!r}")
         pos, orn, lin, ang = self._states[i]
-        rm = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        rm = self.sim.rotation_matrix(orn)
         inverse_inertia = rm @ np.diag(1.0 / self.body_inertia[i]) @ rm.T
         new_lin = np.asarray(lin) + dp / self._mass[i]
         new_ang = np.asarray(ang) + inverse_inertia @ dl

@@ -15,9 +15,12 @@ and ``omega_dot = J_l phi_ddot + (d/dt J_l) phi_dot``. ``J_l`` is singular where
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from sgc_env.paper import quaternion
 
 __all__ = [
     "MAX_COURSE_ROTATION",
@@ -30,7 +33,7 @@ __all__ = [
     "orientation_deviation",
     "quat_to_rotvec",
     "rotvec_to_quat",
-    "unwrap_rotvec",
+    "split_rotation",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -50,6 +53,39 @@ def course_pieces(rotation_vector) -> int:
     """How many equal courses a relative rotation is split into (see MAX_COURSE_ROTATION)."""
     angle = float(np.linalg.norm(np.asarray(rotation_vector, dtype=float)))
     return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
+
+
+def split_rotation(
+    rotation_vector: Sequence[float],
+    t0: float,
+    t1: float,
+    control_frequency: int | None = None,
+    where: str = "relative rotation",
+) -> list[tuple[tuple[float, float, float], float]]:
+    """A relative rotation from ``t0`` to ``t1`` as :func:`course_pieces` equal sub-rotations
+    about its axis: ``(sub-rotation vector, end time)`` per course (the one splitter of the
+    env's tracks and :func:`sgc_env.paper.plan.plan_body`).
+
+    With ``control_frequency`` the courses are timed as the env times them, on its control
+    grid: course ``i`` of ``m`` ends on tick ``k0 + round(i (k1 - k0) / m)`` with ``k0, k1``
+    the ticks of ``t0, t1``, and fewer ticks than courses is an error naming ``where``.
+    Without it they are spaced evenly in continuous time; the last ends exactly at ``t1``.
+    """
+    rel = tuple(float(c) for c in rotation_vector)
+    m = course_pieces(rel)
+    step = (rel[0] / m, rel[1] / m, rel[2] / m)
+    if control_frequency is None:
+        return [(step, t1 if i == m else t0 + (t1 - t0) * i / m) for i in range(1, m + 1)]
+    f = control_frequency
+    k0, k1 = round(t0 * f), round(t1 * f)
+    if k1 - k0 < m:
+        angle = math.sqrt(sum(c * c for c in rel))
+        raise ValueError(
+            f"{where}: a relative rotation of {angle:.6g} rad is split into {m} courses of at "
+            f"most {MAX_COURSE_ROTATION:.4g} rad, which needs {m} control ticks before the goal "
+            f"time but only {k1 - k0} are left; give the goal more time"
+        )
+    return [(step, (k0 + round(i * (k1 - k0) / m)) / f) for i in range(1, m + 1)]
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -163,28 +199,7 @@ def quat_to_rotvec(quat) -> np.ndarray:
     return Rotation.from_quat(np.asarray(quat, dtype=float)).as_rotvec()
 
 
-def unwrap_rotvec(phi_new, phi_prev) -> np.ndarray:
-    """The representative ``phi_new + 2 pi n axis`` of the same rotation closest to ``phi_prev``.
-
-    Keeps a tracked deviation continuous through ``|phi| = pi`` (somersaults). For the identity
-    the axis is taken from ``phi_prev``.
-    """
-    phi_new = np.asarray(phi_new, dtype=float)
-    prev = np.asarray(phi_prev, dtype=float)
-    theta = float(np.linalg.norm(phi_new))
-    if theta < 1e-12:
-        pn = float(np.linalg.norm(prev))
-        if pn == 0.0:
-            return phi_new.copy()
-        n = round(pn / _TWO_PI)
-        return phi_new + (n * _TWO_PI / pn) * prev
-    axis = phi_new / theta
-    n = round((float(axis @ prev) - theta) / _TWO_PI)
-    # the same rotation is also -axis (2 pi - theta): both families are theta + 2 pi n on axis
-    return axis * (theta + n * _TWO_PI)
-
-
 def orientation_deviation(current: Rotation, goal: Rotation, phi_prev=None) -> np.ndarray:
     """``phi = Log(R_current R_goal^T)``, unwrapped against ``phi_prev`` when given."""
     phi = (current * goal.inv()).as_rotvec()
-    return phi if phi_prev is None else unwrap_rotvec(phi, phi_prev)
+    return phi if phi_prev is None else np.array(quaternion.unwrap_rotvec(phi, phi_prev))

@@ -36,9 +36,9 @@ from sgc_env.paper.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_v
 from sgc_env.paper.frames import solve_course_in_frame as _solve_in_frame
 from sgc_env.paper.orientation import (
     angular_acceleration,
-    course_pieces,
     left_jacobian,
     left_jacobian_inverse_apply,
+    split_rotation,
 )
 
 __all__ = [
@@ -103,13 +103,21 @@ class OrientationGoal:
 
 @dataclass(frozen=True)
 class PlanOptions:
-    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there)."""
+    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there) and the
+    control grid split somersaults are timed on."""
 
     c_low: float = C_LOW
     c_high: float = C_HIGH
     k_min: float = K_MIN
+    control_frequency: int | None = None
+    """Time a split somersault's sub-courses on this control grid, as the env does (None:
+    evenly in continuous time)."""
 
     def __post_init__(self) -> None:
+        if self.control_frequency is not None and not self.control_frequency > 0:
+            raise ValueError(
+                f"options: control_frequency must be > 0, got {self.control_frequency!r}"
+            )
         if not 0.8 < self.c_low:
             raise ValueError(f"options: c_low must be > 0.8 (paper eq. 12), got {self.c_low!r}")
         if not 0.0 < self.c_high < 1.0:
@@ -251,13 +259,14 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
     return out
 
 
-def _orientation_courses(r0, goals, times):
+def _orientation_courses(r0, goals, times, control_frequency=None):
     """(goal rotation, phi at the course start, end time, goal index) per course, and the
     rotation each goal reaches.
 
     A relative rotation longer than ``MAX_COURSE_ROTATION`` becomes equal sub-rotations about
-    its axis, evenly timed, as in the env: a course starting on ``|phi| = 2 pi`` could not
-    carry the angular velocity across its axis.
+    its axis (:func:`~sgc_env.paper.orientation.split_rotation`, the env's splitter): a course
+    starting on ``|phi| = 2 pi`` could not carry the angular velocity across its axis. With a
+    ``control_frequency`` the sub-courses end on the env's ticks.
     """
     out, reached = [], []
     prev, t_prev = r0, 0.0
@@ -271,18 +280,16 @@ def _orientation_courses(r0, goals, times):
             prev = goal
         else:
             rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
-            m = course_pieces(rel)
-            for j in range(1, m + 1):
-                prev = Rotation.from_rotvec(rel / m) * prev
-                end = times[i] if j == m else t_prev + (times[i] - t_prev) * j / m
-                out.append((prev, -rel / m, end, i))
+            for step, end in split_rotation(rel, t_prev, times[i], control_frequency, where):
+                prev = Rotation.from_rotvec(step) * prev
+                out.append((prev, -np.array(step), end, i))
         reached.append(prev)
         t_prev = times[i]
     return out, reached
 
 
 def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
-    pieces, reached = _orientation_courses(r0, goals, times)
+    pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
     courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))

@@ -16,6 +16,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
 __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
 
 #: (summary key, column title, format) of the comparison table.
@@ -69,14 +71,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
     parser.add_argument("--episodes", type=int, default=5, help="episodes per pair")
-    parser.add_argument("--seed", type=int, default=1000, help="episode k uses seed + k")
+    parser.add_argument("--seed", type=int, default=EVAL_SEED, help="episode k uses seed + k")
     parser.add_argument("--out", type=Path, default=None, help="output folder (see above)")
     parser.add_argument(
-        "--tolerance-position", type=float, default=0.02, metavar="M",
+        "--tolerance-position", type=float, default=POSITION_TOLERANCE, metavar="M",
         help="success: position error at the goal's tick within this",
     )  # fmt: skip
     parser.add_argument(
-        "--tolerance-orientation", type=float, default=0.05, metavar="RAD",
+        "--tolerance-orientation", type=float, default=ORIENTATION_TOLERANCE, metavar="RAD",
         help="success: orientation error at the goal's tick within this",
     )  # fmt: skip
     parser.add_argument(

@@ -49,8 +49,7 @@ def make_env(scenario: str | None, env_id: str | None, render: bool) -> tuple[An
         loaded = sgc_env.load_scenario(scenario)
         return SGCEnv(scenario=loaded, render_mode=mode), loaded.name
     env_id = env_id or "SGCPoint-v0"
-    if env_id not in gym.registry:
-        raise ValueError(f"env: unknown environment {env_id!r}; SGC ids: {list(sgc_env.ENV_IDS)}")
+    sgc_env.check_env_id(env_id, "env")
     return gym.make(env_id, render_mode=mode), env_id
 
 

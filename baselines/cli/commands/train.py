@@ -8,6 +8,7 @@ import shlex
 import sys
 
 from baselines.cli.commands.demos import add_push_arguments, parse_env_kwargs, push_options
+from sgc_env.defaults import EVAL_SEED
 
 ALGOS = ("ppo", "sac", "td3", "her")
 
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--eval-freq", type=int, default=0, help="env steps between harness evaluations (0: off)"
     )
     parser.add_argument("--eval-episodes", type=int, default=10, help="episodes per evaluation")
-    parser.add_argument("--eval-seed", type=int, default=10_000, help="first held-out seed")
+    parser.add_argument("--eval-seed", type=int, default=EVAL_SEED, help="first held-out seed")
     parser.add_argument(
         "--checkpoint-freq", type=int, default=0, help="env steps between checkpoints (0: off)"
     )
