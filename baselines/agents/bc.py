@@ -58,7 +58,7 @@ def actor_parameters(model: BaseAlgorithm) -> list[th.nn.Parameter]:
         skip |= {id(p) for p in value_net.parameters()}
         skip.add(id(policy.log_std))
         return [p for p in policy.parameters() if id(p) not in skip]
-    return list(policy.actor.parameters())
+    return list(cast(Any, policy).actor.parameters())
 
 
 def _sync_targets(model: BaseAlgorithm) -> None:

@@ -161,7 +161,7 @@ def run_demo(
     return result
 
 
-def _per_rod(record: Any, rows: Sequence[dict[str, Any]], scenario: Any) -> list[dict[str, Any]]:
+def _per_rod(record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any) -> list[dict[str, Any]]:
     """Exactness, punctuality and smoothness for each rod, from the harness's rows and card."""
     out = []
     for b, body in enumerate(scenario.bodies):

@@ -23,7 +23,7 @@ import gymnasium as gym
 import numpy as np
 
 from sgc_env.defaults import POSITION_TOLERANCE
-from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
+from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv, StepInfo
 
 __all__ = ["GoalRewardAccess", "SGCGoalEnv"]
 
@@ -54,16 +54,16 @@ class SGCGoalEnv(SGCEnv):
             "desired_goal": self.task.desired_goal(0),
         }
 
-    def reset(
+    def reset(  # type: ignore[override]  # a Dict observation where SGCEnv has a Box
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    ) -> tuple[dict[str, np.ndarray], StepInfo]:
         _, info = super().reset(seed=seed, options=options)
         self._last = self._dict_obs()
         return self._last, info
 
-    def step(
+    def step(  # type: ignore[override]  # a Dict observation where SGCEnv has a Box
         self, action: np.ndarray
-    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, StepInfo]:
         desired = self._last["desired_goal"]
         _, _, terminated, truncated, info = super().step(action)
         obs = self._dict_obs()

@@ -80,11 +80,12 @@ import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
@@ -175,7 +176,7 @@ class SGCEnv(gym.Env):
         render_mode: str | None = None,
         camera: dict[str, Any] | None = None,
     ) -> None:
-        self._init_kwargs = {
+        self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
@@ -190,7 +191,11 @@ class SGCEnv(gym.Env):
         self.camera = CameraConfig.from_dict(camera)
         self._random_config: RandomScenarioConfig | None = None
         if scenario is None:
-            cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
+            cfg = (
+                PRESETS[random_scenario]
+                if isinstance(random_scenario, str)
+                else cast(RandomScenarioConfig, random_scenario)  # not None: checked above
+            )
             if control_frequency is not None:
                 cfg = RandomScenarioConfig(
                     **{**cfg.__dict__, "control_frequency": control_frequency}
@@ -300,15 +305,12 @@ class SGCEnv(gym.Env):
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        self.max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        self.max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         self._prop_table = self._prop_positions(s)
         if self._markers is not None:
             self._markers.place(s)
 
-    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, float, float]]]:
+    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, ...]]]:
         """Kinematic prop positions at every substep time of the episode (computed once)."""
         if not s.props:
             return []
@@ -328,7 +330,7 @@ class SGCEnv(gym.Env):
 
     # ---------------------------------------------------------------- reset / step
 
-    def reset(
+    def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, StepInfo]:
         super().reset(seed=seed)
@@ -414,7 +416,9 @@ class SGCEnv(gym.Env):
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
+    def step(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
+        self, action: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
         if a.shape != self._action_shape:
             raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
@@ -451,7 +455,7 @@ class SGCEnv(gym.Env):
                 for kh, c in coef
             ]
             drives.append((self._uids[i], f, tq, path))
-        moves: list[list[tuple[int, tuple[float, float, float]]]] = []
+        moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
             last = len(self._prop_table) - 1  # props hold still if stepped past truncation

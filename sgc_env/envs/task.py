@@ -255,7 +255,7 @@ class GoalTask:
             self.phi,
         )
         points = []
-        deviations = []
+        deviations: list[tuple[float, ...]] = []
         ptls = []
         otls = []
         for i, (pos, orn, lin, ang) in enumerate(states):

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -244,8 +244,10 @@ def course_end_velocity(
     d = _vec3(d_start, "d_start")
     if not (math.isfinite(t_course) and t_course > 0.0):
         raise ValueError(f"t_course must be finite and > 0, got {t_course!r}")
-    nxt = None if d_next is None else _vec3(d_next, "d_next")
-    if nxt is not None and _negligible(nxt, d):
+    nxt: tuple[float, float, float] | str | None = (
+        None if d_next is None else _vec3(d_next, "d_next")
+    )
+    if isinstance(nxt, tuple) and _negligible(nxt, d):
         nxt = "rest"
     elif nxt is not None and (t_next is None or not (math.isfinite(t_next) and t_next > 0.0)):
         raise ValueError(f"t_next must be finite and > 0, got {t_next!r}")
@@ -274,7 +276,7 @@ def course_end_velocity(
         zeros = np.zeros(3)
         return zeros, EndVelocity(zeros, np.array(rows), np.full(3, np.nan), zeros, 0.0, True,
                                   "rest")
-    if nxt is not None:
+    if isinstance(nxt, tuple) and t_next is not None:  # t_next was checked with nxt above
         rho = tuple(c / t_next / avg for c in _mul(rows, nxt))
         n0, n1, n2 = nxt
         speed_ratio = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) * t_course / (norm * t_next)
@@ -365,6 +367,7 @@ def solve_course_in_frame(
     """
     if not (math.isfinite(time_left) and time_left > 0.0):
         raise ValueError(f"time_left must be finite and > 0, got {time_left!r}")
+    rows: Any
     if frame is None:
         rows = _IDENTITY_ROWS
     else:

@@ -136,7 +136,7 @@ class CourseDiagnostics:
     index: int
     t_start: float
     t_end: float
-    branches: tuple[str, str, str]
+    branches: tuple[str, ...]
     k: np.ndarray
     turn_angle: float
     within_paper_assumption: bool
