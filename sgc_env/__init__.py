@@ -27,6 +27,7 @@ __all__ = [
 
 _ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
 _GOAL = "sgc_env.envs.goal_env"
+_STEPS = "sgc_env.episode_steps"
 _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
@@ -36,16 +37,18 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 
+_LENGTH_CHECK = WrapperSpec("EpisodeLengthCheck", f"{_STEPS}:EpisodeLengthCheck", {})
+_GOAL_REWARD = WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {})
+
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
-        _goal = _entry.startswith(_GOAL)
         gym.register(
             id=_id,
             entry_point=_entry,
             kwargs=_kwargs,
             max_episode_steps=registered_steps(_kwargs),
             additional_wrappers=(
-                (WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {}),) if _goal else ()
+                (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else (_LENGTH_CHECK,)
             ),
         )
 

@@ -4,7 +4,10 @@ The env truncates by itself at the last goal's tick plus ``scenario.margin``; th
 bound lets tools that read the spec (``TimeLimit``, ``TimeAwareObservation``, rl-zoo3) know
 it. A built-in scenario's bound equals the env's own (both truncate on the same step); a
 random-scenario id's bound covers every draw of its preset, so its TimeLimit never cuts an
-episode short of the env's own truncation.
+episode short of the env's own truncation. The bound is for the registered arguments: a
+longer scenario (``scenario=``, ``reset(options={"scenario": ...})``, a higher
+``control_frequency``) would be cut short silently, so :class:`EpisodeLengthCheck` (the
+outermost registered wrapper) turns that into a ``ValueError`` at reset.
 """
 
 from __future__ import annotations
@@ -13,12 +16,13 @@ import math
 from importlib import resources
 from typing import Any
 
+import gymnasium as gym
 import yaml
 
 from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
 
-__all__ = ["random_steps_bound", "registered_steps", "scenario_steps"]
+__all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
 
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
@@ -61,3 +65,30 @@ def registered_steps(kwargs: dict[str, Any]) -> int:
     name = kwargs["scenario"]
     text = (resources.files("sgc_env") / "scenarios" / f"{name}.yaml").read_text()
     return scenario_steps(scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name))
+
+
+class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Refuses, at reset, an episode that the registered ``TimeLimit`` would end too early.
+
+    Only the registry's own bound is checked: a ``max_episode_steps`` passed to ``gym.make``
+    is the caller's choice and is left alone.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.Wrapper.__init__(self, env)
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        result = self.env.reset(**kwargs)
+        spec, base = self.env.spec, self.env.unwrapped
+        limit = None if spec is None else spec.max_episode_steps
+        needed = int(getattr(base, "max_steps", 0))
+        if limit is not None and needed > limit and base.spec is not None:
+            registered = gym.spec(base.spec.id).max_episode_steps
+            if limit == registered:
+                raise ValueError(
+                    f"{base.spec.id}: this episode lasts {needed} steps but the registered "
+                    f"TimeLimit ends episodes after {limit}; pass max_episode_steps={needed} "
+                    "(or -1 for no TimeLimit) to gym.make"
+                )
+        return result

@@ -74,3 +74,16 @@ def test_sb3_checker_passes_on_the_made_env(env_id: str) -> None:
         env = gym.make(env_id)
         sb3_check_env(env)
         env.close()
+
+
+def test_a_longer_episode_than_the_registered_limit_is_refused() -> None:
+    """A scenario the registry's TimeLimit would cut short is an error, not a silent cut."""
+    kwargs = {"scenario": "point_three_goals", "control_frequency": 240}
+    env = gym.make("SGCPoint-v0", **kwargs)
+    with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
+        env.reset(seed=0)
+    env.close()
+    for steps in (-1, 420, 100):  # the caller's own limit (or none) is respected
+        env = gym.make("SGCPoint-v0", max_episode_steps=steps, **kwargs)
+        env.reset(seed=0)
+        env.close()
