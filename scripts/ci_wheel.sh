@@ -16,8 +16,9 @@ wheel="$(ls "$work"/dist/sgc-*.whl)"
 unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenarios/three_rods.yaml|ppo_dagger_SGCPoint"
 step "2/4 install $(basename "$wheel")[rl] into a fresh venv"
 python3 -m venv "$work/venv"
-"$work/venv/bin/python" -m pip install --progress-bar off -q -c "$root/constraints.txt" \
-    "torch==2.13.0" "${wheel}[rl]"
+# --no-compile: modules compile on first import instead (saves compiling all of torch)
+"$work/venv/bin/python" -m pip install --progress-bar off -q --no-compile \
+    -c "$root/constraints.txt" "torch==2.13.0" "${wheel}[rl]"
 mkdir "$work/elsewhere" && cd "$work/elsewhere"
 "$work/venv/bin/python" - <<'PY'
 import baselines, sgc_env
