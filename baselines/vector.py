@@ -18,6 +18,7 @@ __all__ = ["MODEL_ATTRIBUTES", "base_env", "sub_env"]
 MODEL_ATTRIBUTES = (
     "scenario",
     "body_inertia",
+    "torque_scale",
     "layout",
     "sim_frequency",
     "substeps",

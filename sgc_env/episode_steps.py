@@ -19,8 +19,11 @@ from typing import Any
 import gymnasium as gym
 import yaml
 
-from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig
+from sgc_env.random_intercept import RandomInterceptConfig
+from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig, SceneFamily
+from sgc_env.random_three_rods import RandomThreeRodsConfig
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
+from sgc_env.three_rods import EMBED_DURATION, ROD_SPECS
 
 __all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
 
@@ -40,15 +43,27 @@ def scenario_steps(scenario: Scenario) -> int:
     return max(round(t * f) for t in times) + math.ceil(scenario.margin * f - 1e-9)
 
 
-def random_steps_bound(config: RandomScenarioConfig | str) -> int:
-    """Most steps an episode of a random-scenario preset can last (over every draw).
+def random_steps_bound(config: SceneFamily | str) -> int:
+    """Most steps an episode of a random-scenario preset or family can last (every draw)."""
+    cfg = PRESETS[config] if isinstance(config, str) else config
+    f = cfg.control_frequency
+    if isinstance(cfg, RandomInterceptConfig):  # the meeting is the last goal
+        return math.ceil(cfg.meeting_time[1] * f) + math.ceil(cfg.margin * f - 1e-9)
+    if isinstance(cfg, RandomThreeRodsConfig):
+        # each rod's last goal: its embed, EMBED_DURATION after a hit time drawn within
+        # hit_time_change of the paper's; the margin is the builder's (as in three_rods.yaml)
+        last = max(spec.hit_time for spec in ROD_SPECS) + cfg.hit_time_change + EMBED_DURATION
+        margin = _builtin("three_rods").margin
+        return math.ceil(last * f) + 1 + math.ceil(margin * f - 1e-9)
+    return _courses_bound(cfg)
 
-    Mirrors :func:`~sgc_env.random_scenarios.random_scenario`: a course of length ``L`` is
+
+def _courses_bound(cfg: RandomScenarioConfig) -> int:
+    """Mirrors :func:`~sgc_env.random_scenarios.random_scenario`: a course of length ``L`` is
     flown at no less than ``min(speed_low, cap)``, where ``cap`` (the speed the force budget
     allows after a course flown at ``v_prev``) grows with ``L`` slower than ``L`` and falls
     with ``v_prev``; so ``L / speed`` is largest for the longest course after the fastest one.
     """
-    cfg = PRESETS[config] if isinstance(config, str) else config
     f = cfg.control_frequency
     accel_budget = 0.9 * (cfg.force_limit / cfg.mass - 9.81)
     length, v_prev = cfg.spacing[1], cfg.speed[1]
@@ -62,9 +77,13 @@ def registered_steps(kwargs: dict[str, Any]) -> int:
     """``max_episode_steps`` for an id registered with these ``SGCEnv`` keyword arguments."""
     if kwargs.get("random_scenario") is not None:
         return random_steps_bound(kwargs["random_scenario"])
-    name = kwargs["scenario"]
+    return scenario_steps(_builtin(kwargs["scenario"]))
+
+
+def _builtin(name: str) -> Scenario:
+    """A built-in scenario as written (validated, not resolved: cheap enough for import)."""
     text = (resources.files("sgc_env") / "scenarios" / f"{name}.yaml").read_text()
-    return scenario_steps(scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name))
+    return scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name)
 
 
 class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
