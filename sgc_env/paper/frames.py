@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -284,7 +284,8 @@ def course_end_velocity(
         return zeros, EndVelocity(zeros, np.array(rows), np.full(3, np.nan), zeros, 0.0, True,
                                   "rest")
     if isinstance(nxt, tuple) and t_next is not None:  # t_next was checked with nxt above
-        rho = tuple(c / t_next / avg for c in _mul(rows, nxt))
+        r0, r1, r2 = _mul(rows, nxt)
+        rho = (r0 / t_next / avg, r1 / t_next / avg, r2 / t_next / avg)
         n0, n1, n2 = nxt
         speed_ratio = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) * t_course / (norm * t_next)
         k_floor = k_min * min(1.0, speed_ratio)
@@ -319,7 +320,7 @@ class FrameCourse:
     ) -> None:
         """``frame``: ``S_i`` as a 3x3 array or as a tuple of three row tuples."""
         rows = frame.tolist() if isinstance(frame, np.ndarray) else frame
-        self._rows = tuple(tuple(float(x) for x in r) for r in rows)
+        self._rows: Rows = cast(Rows, tuple(tuple(float(x) for x in r) for r in rows))
         self.profiles = tuple(profiles)
         self.duration = duration
 
