@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from baselines.vector import base_env
 from sgc_env.observation import ObservationLayout
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.end_rules import DEFAULT_END_RULE
@@ -51,7 +52,7 @@ class EnvModel:
     @classmethod
     def from_env(cls, env: Any) -> EnvModel:
         """Read the model of a Gymnasium env (wrapped or not) or of a vector env's first env."""
-        base = _unwrap(env)
+        base = base_env(env)
         scenario = base.scenario
         bodies = tuple(
             BodyModel(
@@ -106,14 +107,3 @@ class EnvModel:
                 out += (bx / sx, by / sy, bz / sz)
         return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
 
-
-def _unwrap(env: Any) -> Any:
-    """The base SGC env behind wrappers, or behind the first sub-env of a vector env."""
-    if hasattr(env, "get_attr") and not hasattr(env, "unwrapped"):
-        return env.get_attr("unwrapped", [0])[0]
-    if hasattr(env, "envs"):
-        return env.envs[0].unwrapped
-    base = env.unwrapped
-    if not hasattr(base, "scenario"):
-        raise TypeError(f"{type(base).__name__} is not an SGC environment (no scenario)")
-    return base

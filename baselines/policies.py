@@ -2,7 +2,8 @@
 
 Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tangent rule),
 ``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``dynamic-constraints``,
-``minimum-jerk``, ``random``, or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
+``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
+:mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
 then). A model trained behind ``VecNormalize``
 gets the statistics ``sgc train`` saved beside it (:func:`vecnormalize_path`), so it sees the
@@ -30,6 +31,7 @@ from baselines.comparison_policies import (
     predict_per_env,
 )
 from baselines.expert import SGCExpert
+from baselines.shipped import resolve_policy_spec
 
 __all__ = [
     "BUILTIN_POLICIES",
@@ -264,6 +266,7 @@ def make_policy(spec: str, env: Any, seed: int | None = None) -> Policy:
     """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``."""
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
+    spec = resolve_policy_spec(spec)
     if spec == "random":
         return RandomPolicy(env.action_space, seed)
     if spec in ("expert", "expert-paper", "dynamic-constraints", "minimum-jerk"):

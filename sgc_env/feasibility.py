@@ -10,7 +10,7 @@ planner (and scipy) load only when a check runs, so ``import sgc_env`` stays lig
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -67,9 +67,13 @@ def _plan(b: Body, control_frequency: int):
         BodyState(
             vec(b.position), vec(b.orientation), vec(b.linear_velocity), vec(b.angular_velocity)
         ),
-        [PositionGoal(g.time, vec(g.nail), vec(g.point)) for g in b.goals if g.has_position],
         [
-            OrientationGoal(g.time, vec(g.orientation), vec(g.relative_rotation))
+            PositionGoal(cast(float, g.time), vec(g.nail), vec(g.point))  # resolved: timed
+            for g in b.goals
+            if g.has_position
+        ],
+        [
+            OrientationGoal(cast(float, g.time), vec(g.orientation), vec(g.relative_rotation))
             for g in b.goals
             if g.has_orientation
         ],

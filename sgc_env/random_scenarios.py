@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -176,7 +177,7 @@ def random_scenario(rng: np.random.Generator, config: SceneFamily | str = "point
     scenario = Scenario(
         bodies=(body,),
         name="random",
-        workspace=(tuple(start - hw), tuple(start + hw)),  # type: ignore[arg-type]
+        workspace=(tuple(start - hw), tuple(start + hw)),
         margin=cfg.margin,
         control_frequency=f,
     )
@@ -215,9 +216,9 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
                 np.asarray(b.position), np.asarray(b.orientation),
                 np.asarray(b.linear_velocity), np.asarray(b.angular_velocity),
             ),
-            [PositionGoal(gl.time, np.asarray(gl.nail), np.asarray(gl.point))
+            [PositionGoal(cast(float, gl.time), np.asarray(gl.nail), np.asarray(gl.point))
              for gl in b.goals if gl.has_position],
-            [OrientationGoal(gl.time, orientation=None if gl.orientation is None
+            [OrientationGoal(cast(float, gl.time), orientation=None if gl.orientation is None
                              else np.asarray(gl.orientation),
                              relative_rotation=None if gl.relative_rotation is None
                              else np.asarray(gl.relative_rotation))

@@ -240,7 +240,7 @@ def parametric_curve(kind: str, **params: Any) -> Callable[[float], np.ndarray]:
 
 
 def path_goals(
-    path: Callable[[float], Sequence[float]],
+    path: Callable[[float], Sequence[float] | np.ndarray],
     samples: int,
     *,
     time: float | None = None,
@@ -789,7 +789,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
     distances: list[float] = []
     weights: list[float] = []
     prev_point: np.ndarray | None = None
-    prev_q = np.asarray(b.orientation, float)
+    prev_q: Any = np.asarray(b.orientation, float)
     for j, g in enumerate(b.goals):
         gp = f"{p}.goals[{j}]"
         crit = g.is_critical
@@ -815,6 +815,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
             dist = float(np.linalg.norm(nail - prev_point)) if nail is not None else 0.0
             prev_point = nail
         if g.has_orientation:
+            q: Any
             if g.relative_rotation is not None:
                 angle = float(np.linalg.norm(g.relative_rotation))
                 q = quat.mul(quat.exp_normalized(g.relative_rotation), prev_q)
@@ -935,7 +936,7 @@ def resolve_scenario(
     for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
         times = _body_goal_times(b, s, s.control_frequency, s.time_grid, p)
-        goals = []
+        goals: list[Goal] = []
         for g, t in zip(b.goals, times, strict=True):
             nail = g.nail
             if g.nail_prop is not None:

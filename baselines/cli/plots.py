@@ -237,7 +237,7 @@ def plot_path_3d(
     pts = traj["point_position"]
     for b in range(pts.shape[1]):
         line = ax.plot(pts[:, b, 0], pts[:, b, 1], pts[:, b, 2], label=f"body {b}")[0]
-        nails = np.array([g.nail for g in goals[b] if g.nail is not None]) if b < len(goals) else []
+        nails = np.array([g.nail for g in goals[b] if g.nail is not None] if b < len(goals) else [])
         if len(nails):
             ax.scatter(
                 nails[:, 0], nails[:, 1], nails[:, 2], marker="x", s=40, color=line.get_color()

@@ -110,11 +110,12 @@ import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.paper.quaternion import rotate
 from sgc_env.random_scenarios import PRESETS, SceneFamily
@@ -171,6 +172,7 @@ class StepInfo(_StepInfoEveryStep, total=False):
     one row per body; ``goal_reached`` only on a tick where goals fall."""
 
     goal_reached: list[GoalEvent]
+    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
 
 
 @dataclass(frozen=True)
@@ -244,7 +246,7 @@ class SGCEnv(gym.Env):
         camera: dict[str, Any] | None = None,
         reward: str = "schedule",
     ) -> None:
-        self._init_kwargs = {
+        self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
@@ -262,7 +264,11 @@ class SGCEnv(gym.Env):
         self.camera = CameraConfig.from_dict(camera)
         self._random_config: SceneFamily | None = None
         if scenario is None:
-            cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
+            cfg = (
+                PRESETS[random_scenario]
+                if isinstance(random_scenario, str)
+                else cast(SceneFamily, random_scenario)  # not None: checked above
+            )
             if control_frequency is not None:
                 cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
@@ -370,10 +376,7 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
         return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
 
@@ -410,7 +413,7 @@ class SGCEnv(gym.Env):
 
     # ---------------------------------------------------------------- reset / step
 
-    def reset(
+    def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, StepInfo]:
         self._check_open()
@@ -501,7 +504,9 @@ class SGCEnv(gym.Env):
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
+    def step(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
+        self, action: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         if self._closed:
             self._check_open()
         a = action if type(action) is np.ndarray else np.asarray(action)
@@ -546,7 +551,7 @@ class SGCEnv(gym.Env):
                 for kh, c in coef
             ]
             drives.append((self._uids[i], f, tq, path))
-        moves: list[list[tuple[int, tuple[float, float, float]]]] = []
+        moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
             at = self._props.at

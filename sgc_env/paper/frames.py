@@ -58,7 +58,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -295,8 +295,10 @@ def course_end_velocity(
     d = _vec3(d_start, "d_start")
     if not (math.isfinite(t_course) and t_course > 0.0):
         raise ValueError(f"t_course must be finite and > 0, got {t_course!r}")
-    nxt = None if d_next is None else _vec3(d_next, "d_next")
-    if nxt is not None and _negligible(nxt, d):
+    nxt: tuple[float, float, float] | str | None = (
+        None if d_next is None else _vec3(d_next, "d_next")
+    )
+    if isinstance(nxt, tuple) and _negligible(nxt, d):
         nxt = "rest"
     elif nxt is not None and (t_next is None or not (math.isfinite(t_next) and t_next > 0.0)):
         raise ValueError(f"t_next must be finite and > 0, got {t_next!r}")
@@ -325,8 +327,9 @@ def course_end_velocity(
         zeros = np.zeros(3)
         return zeros, EndVelocity(zeros, np.array(rows), np.full(3, np.nan), zeros, 0.0, True,
                                   "rest")
-    if nxt is not None:
-        rho = tuple(c / t_next / avg for c in _mul(rows, nxt))
+    if isinstance(nxt, tuple) and t_next is not None:  # t_next was checked with nxt above
+        r0, r1, r2 = _mul(rows, nxt)
+        rho = (r0 / t_next / avg, r1 / t_next / avg, r2 / t_next / avg)
         n0, n1, n2 = nxt
         speed_ratio = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) * t_course / (norm * t_next)
         k_floor = k_min * min(1.0, speed_ratio)
@@ -397,7 +400,7 @@ class FrameCourse:
     ) -> None:
         """``frame``: ``S_i`` as a 3x3 array or as a tuple of three row tuples."""
         rows = frame.tolist() if isinstance(frame, np.ndarray) else frame
-        self._rows = tuple(tuple(float(x) for x in r) for r in rows)
+        self._rows: Rows = cast(Rows, tuple(tuple(float(x) for x in r) for r in rows))
         self.profiles = tuple(profiles)
         self.duration = duration
 
@@ -460,6 +463,7 @@ def solve_course_in_frame(
     """
     if not (math.isfinite(time_left) and time_left > 0.0):
         raise ValueError(f"time_left must be finite and > 0, got {time_left!r}")
+    rows: Any
     if frame is None:
         rows = _IDENTITY_ROWS
     else:

@@ -28,6 +28,7 @@ import bisect
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -151,7 +152,7 @@ class CourseDiagnostics:
     index: int
     t_start: float
     t_end: float
-    branches: tuple[str, str, str]
+    branches: tuple[str, ...]
     k: np.ndarray
     turn_angle: float
     within_paper_assumption: bool
@@ -329,7 +330,7 @@ def _orientation_courses(
         if (g.orientation is None) == (g.relative_rotation is None):
             raise ValueError(f"{where}: give exactly one of orientation and relative_rotation")
         if g.relative_rotation is None:
-            goal = _quat(g.orientation, where, "orientation")
+            goal = _quat(cast(np.ndarray, g.orientation), where, "orientation")  # checked above
             out.append((goal, (prev * goal.inv()).as_rotvec(), times[i], i))
             prev = goal
         else:
@@ -354,7 +355,9 @@ def _plan_orientation(
     pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
-    courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
+    courses: list[Any] = []
+    t_prev = 0.0
+    phi_dot: np.ndarray = np.array(left_jacobian_inverse_apply(starts[0], w0))
     for i, phi0 in enumerate(starts):
         T = ends[i] - t_prev
         last = i == len(starts) - 1
@@ -478,7 +481,9 @@ def plan_body(
     p_times = _check_times([g.time for g in position_goals], "position")
     o_times = _check_times([g.time for g in orientation_goals], "orientation")
     diags: list[CourseDiagnostics] = []
-    rots, goal_rots, o_track = [], [], None
+    rots: list[Rotation] = []
+    goal_rots: list[Rotation] = []
+    o_track = None
     if orientation_goals:
         rots, goal_rots, o_track = _plan_orientation(
             r0, w0, orientation_goals, o_times, end_w, opts, diags

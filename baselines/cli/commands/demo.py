@@ -39,11 +39,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import gymnasium as gym
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
     from rich.table import Table
 
-    from baselines.cli.demo import DemoOptions, cpu_seconds, run_demo
+    import sgc_env  # noqa: F401  (registers the ids)
+    from baselines.cli.demo import ENV_ID, DemoOptions, cpu_seconds, run_demo
 
     console = Console()
     started = time.perf_counter()
@@ -57,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
             out=stage, width=args.width, height=args.height, video=not args.no_video,
             end_rule="paper" if args.paper_rule else "tangent",
         )  # fmt: skip
-        task = bar.add_task("demo", total=None)
+        # the registry's episode length is the demo's tick count, known before the env is built
+        task = bar.add_task("demo", total=gym.spec(ENV_ID).max_episode_steps)
         result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
         files = sorted(args.out / path.relative_to(stage) for path in result.files.values())
     elapsed = time.perf_counter() - started
