@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import sys
 from collections.abc import Sequence
+
+from baselines.cli.checks import UsageError
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -35,8 +38,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return int(args._module.run(args) or 0)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0), or a bad argument reported in one line (2)
+        return int(exc.code or 0)
+    try:
+        return int(args._module.run(args) or 0)
+    except UsageError as exc:  # a bad argument found before any work; real bugs still raise
+        print(f"sgc {args.command}: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

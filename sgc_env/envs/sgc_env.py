@@ -8,12 +8,19 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz in the world frame,
-scaled by the body's ``force_limit`` (N) and ``torque_limit`` (N m). When every body is a
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
+``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
+``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
+that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
+axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
+start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
+its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
+1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
+orientation goal; scaled body axes make every axis equally sensitive. When every body is a
 sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
 the centre of mass; gravity is *not* compensated. The action is held for one control period
 (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep.
+every substep (the world torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -40,17 +47,38 @@ reaches t_i already describes goal i+1.
 
 ## Rewards
 
-``r = -mean_b(|D_b| / L_b + |phi_b| / A_b) - 0.01 * mean(a^2) + sum over goals met this tick of
-exp(-|D| / 0.01 m) (+ exp(-|phi| / 0.02 rad))``, with ``L_b = max(|D_i(0)|, 0.1 m)`` and
-``A_b = max(|phi_i(0)|, 0.5 rad)`` of the current course. Dense, bounded by the bonus.
+``reward=`` (constructor, ``gym.make(id, reward=...)``) picks one of three modes
+(:mod:`sgc_env.envs.rewards` has the code; ``D`` the tracked point's deviation, ``D_i(0)`` and
+``T_i`` the current course's start deviation and duration, ``L = max(|D_i(0)|, 0.1 m)``; the
+same for orientation with ``phi`` and ``A = max(|phi_i(0)|, 0.5 rad)``; ``bonus`` = per goal met
+this tick ``exp(-|D| / 0.01 m)`` (+ ``exp(-|phi| / 0.02 rad)``); means over bodies):
+
+- ``"schedule"`` (default): ``r = -mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2)
+  + bonus`` with ``D_sched = D_i(0) time_left / T_i`` (after the last goal ``-v_end
+  time_left``, carrying on at the end velocity). ``D_sched`` is the paper's behaviour equation
+  ``D'' - 2a D' + (a^2 + b^2) D = 0``, ``D(T) = 0``, ``D'(T) = -k D0 / T`` in its neutral member
+  (``k = 1``, ``a = b = 0``): the course travelled on schedule. It depends only on the course
+  and the clock, so the cost vanishes only where the body should be *now*: reaching the nail
+  early and hovering costs ``time_left / T_i`` per step, as does arriving late, and the bonus
+  pays for exactness on the tick; the SGC expert departs from it only by its smooth course
+  starts and earns close to the maximum.
+- ``"distance"`` (the reward before the modes): ``r = -mean_b(|D| / L + |phi| / A) - 0.01
+  mean(a^2) + bonus``. It pays for reaching the nail early and hovering, and ranks the early,
+  inexact dynamic-constraints controller above the expert; kept for comparison.
+- ``"sparse"``: ``r = -0.01 mean(a^2) + bonus``.
+
+A failure (``terminated``) under ``schedule`` and ``sparse`` also charges every step the episode
+had left at the mode's worst per-step reward (``mean_b(tracks) + 0.01``, resp. ``0.01``; the
+per-track cost is capped at 1 for this), so leaving the workspace never ends a negative stream
+early; ``distance`` charges nothing, as before. An unknown mode is a ``ValueError`` naming the
+choices.
 
 ## Episode end
 
 ``truncated`` at the last goal time + ``scenario.margin`` (reaching a goal never ends an
 episode). ``terminated`` on failure: non-finite state, a body CoM outside the workspace box, or
-a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s; a
-thin rod's axial spin reaches that within a step under random torques, so it is not terminal:
-``info["spin_clamped"]`` flags it (the physics is then no longer exact).
+a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s;
+that is not terminal: ``info["spin_clamped"]`` flags it (the physics is then no longer exact).
 
 ## Info
 
@@ -58,17 +86,18 @@ Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_g
 (index into the body's goal list, -1 without a track), ``position_deviation``,
 ``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
 ``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
-``{body, goal, time, position_error, orientation_error}`` (norms of D and phi at that tick;
-None for a missing part).
+``{body, goal, time, position_error, orientation_error}`` (|D| and the angle between body and
+goal orientation, in [0, pi], at that tick; None for a missing part).
 
 ## Arguments
 
-``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
-:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
-reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
-an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
+``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
+(240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
-distance, yaw, pitch, target, width, height). ``reset(options={"scenario": ...})`` swaps the
+distance, yaw, pitch, target, width, height), ``reward`` (``"schedule"``, ``"distance"`` or
+``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
 plain reset).
 """
@@ -77,8 +106,9 @@ from __future__ import annotations
 
 import math
 import struct
+import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypedDict
 
@@ -86,13 +116,16 @@ import gymnasium as gym
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.paper.quaternion import rotate
+from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.simulator import Drive, Simulator
 
-from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction, TaskCounters
+from .props import PropPaths
+from .rewards import make_reward
+from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
 
 __all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
@@ -141,11 +174,46 @@ class StepInfo(_StepInfoEveryStep, total=False):
 
 
 @dataclass(frozen=True)
+class _Prepared:
+    """A scenario checked against an env, with what it compiles to (see SGCEnv._prepare)."""
+
+    scenario: Scenario
+    task: GoalTask
+    max_steps: int
+    props: PropPaths
+
+
+@dataclass(frozen=True)
 class SavedState:
     """A snapshot from :meth:`SGCEnv.save_state`: the PyBullet state id plus env counters."""
 
     bullet_state: int
     counters: dict[str, Any]
+
+    def free(self) -> None:
+        """Free the PyBullet copy now instead of when this object is garbage-collected."""
+        release = getattr(self, "_release", None)
+        if release is not None:
+            release()
+
+    @property
+    def alive(self) -> bool:
+        """False once freed (explicitly or because its env closed)."""
+        release = getattr(self, "_release", None)
+        if release is None:
+            return True
+        details = release.peek()
+        return details is not None and _sim_open(details[2][0])
+
+
+def _sim_open(sim_ref: weakref.ref[Simulator]) -> bool:
+    sim = sim_ref()
+    return sim is not None and sim.client >= 0
+
+
+def _remove_state(sim_ref: weakref.ref[Simulator], state_id: int) -> None:
+    if _sim_open(sim_ref):
+        sim_ref().remove_state(state_id)  # type: ignore[union-attr]
 
 
 def _as_scenario(spec: Scenario | str | Path) -> Scenario:
@@ -168,18 +236,22 @@ class SGCEnv(gym.Env):
         self,
         scenario: Scenario | str | Path | None = None,
         *,
-        random_scenario: RandomScenarioConfig | str | None = None,
+        random_scenario: SceneFamily | str | None = None,
         control_frequency: int | None = None,
         sim_frequency: int = 240,
         time_grid: str | None = None,
         render_mode: str | None = None,
         camera: dict[str, Any] | None = None,
+        reward: str = "schedule",
     ) -> None:
         self._init_kwargs = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
+            "reward": reward,
         }  # fmt: skip
+        self.reward_mode = reward
+        self._reward: RewardFunction = make_reward(reward)
         if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
             raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
         if scenario is None and random_scenario is None:
@@ -188,13 +260,11 @@ class SGCEnv(gym.Env):
             )
         self.render_mode = render_mode
         self.camera = CameraConfig.from_dict(camera)
-        self._random_config: RandomScenarioConfig | None = None
+        self._random_config: SceneFamily | None = None
         if scenario is None:
             cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
             if control_frequency is not None:
-                cfg = RandomScenarioConfig(
-                    **{**cfg.__dict__, "control_frequency": control_frequency}
-                )
+                cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
@@ -235,14 +305,21 @@ class SGCEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
-        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
-        self._reward: RewardFunction = DistanceReward()
         self._markers: NailMarkers | None = None
+        self._closed = False
         self.scenario: Scenario = base
         self._geometry: tuple = ()
-        self._build(base)
-        self._set_scenario(base)
-        self._reset_state()
+        # Everything that can reject the scenario runs before the PyBullet client exists; if
+        # building the scene still fails, the client is closed before the error propagates.
+        prepared = self._prepare(base)
+        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        try:
+            self._build(base)
+            self._commit(prepared)
+            self._reset_state()
+        except BaseException:
+            self.sim.close()
+            raise
 
     # ---------------------------------------------------------------- scenario handling
 
@@ -275,6 +352,12 @@ class SGCEnv(gym.Env):
             self._markers.clear()
 
     def _set_scenario(self, s: Scenario) -> None:
+        """Switch to ``s`` all at once: everything is checked and compiled before the env
+        changes, so a rejected scenario leaves the env exactly as it was."""
+        self._commit(self._prepare(s))
+
+    def _prepare(self, s: Scenario) -> _Prepared:
+        """Check ``s`` against this env and compile its tracks; changes nothing."""
         if len(s.bodies) != self._n:
             raise ValueError(
                 f"scenario has {len(s.bodies)} bodies, this env was made for {self._n}"
@@ -287,54 +370,58 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
+        last_tick = max(
+            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
+        )
+        max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
+        return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
+
+    def _commit(self, prepared: _Prepared) -> None:
+        """Make a prepared scenario current. Rebuilding bodies is the one step that talks to
+        PyBullet; if it fails, the previous scene is rebuilt before the error propagates."""
+        s = prepared.scenario
         if _geometry(s) != self._geometry:
-            self._build(s)
+            previous = self.scenario
+            try:
+                self._build(s)
+            except BaseException:
+                self._build(previous)
+                raise
         self.scenario = s
         self.sim.set_gravity(s.gravity)
         self._gravity = tuple(float(g) for g in s.gravity)
-        self.task = GoalTask(s, self._reward)
+        self.task = prepared.task
+        self.max_steps = prepared.max_steps
+        self._props = prepared.props
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
-        self._tlimit = [float(b.torque_limit) for b in s.bodies]
+        self.torque_scale = np.array(
+            [float(b.torque_limit) * inertia / inertia.max()
+             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        )  # fmt: skip
+        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        self.max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
-        self._prop_table = self._prop_positions(s)
         if self._markers is not None:
             self._markers.place(s)
-
-    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, float, float]]]:
-        """Kinematic prop positions at every substep time of the episode (computed once)."""
-        if not s.props:
-            return []
-        n_sub = (self.max_steps + 1) * self.substeps + 1
-        t = np.arange(n_sub) / self.sim_frequency
-        table = []
-        for p in s.props:
-            if p.waypoints:
-                times = [w[0] for w in p.waypoints]
-                pts = np.asarray([w[1] for w in p.waypoints])
-                xyz = np.stack([np.interp(t, times, pts[:, j]) for j in range(3)], axis=1)
-            else:
-                xyz = np.asarray(p.position) + np.outer(t, p.velocity)
-            table.append(xyz)
-        arr = np.stack(table, axis=1)
-        return [[tuple(map(float, row)) for row in step] for step in arr]
 
     # ---------------------------------------------------------------- reset / step
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, StepInfo]:
-        super().reset(seed=seed)
+        self._check_open()
         options = options or {}
+        prepared = None
         if options.get("scenario") is not None:
-            self._set_scenario(self._resolve(_as_scenario(options["scenario"])))
+            # Checked and compiled before the seed or anything else changes (transactional).
+            prepared = self._prepare(self._resolve(_as_scenario(options["scenario"])))
+        super().reset(seed=seed)
+        if prepared is not None:
+            self._commit(prepared)
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
@@ -349,7 +436,7 @@ class SGCEnv(gym.Env):
                 uid, b.position, b.orientation, b.linear_velocity, b.angular_velocity
             )
         if self._prop_uids:
-            for uid, pos in zip(self._prop_uids, self._prop_table[0], strict=True):
+            for uid, pos in zip(self._prop_uids, self._props.at(0), strict=True):
                 self.sim.move(uid, pos)
         self._tick = 0
         self._zeros3n = [0.0] * (3 * self._n)
@@ -415,14 +502,22 @@ class SGCEnv(gym.Env):
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
-        a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
+        if self._closed:
+            self._check_open()
+        a = action if type(action) is np.ndarray else np.asarray(action)
+        if a.dtype.kind not in "fiu":
+            raise TypeError(f"action must hold real numbers, got dtype {a.dtype}: {action!r}")
         if a.shape != self._action_shape:
             raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
         values = a.tolist()
-        if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
-            raise ValueError(f"action contains non-finite values: {values}")
-        if max(values) > 1.0 or min(values) < -1.0:
+        hi, lo = max(values), min(values)
+        if hi > 1.0 or lo < -1.0:
+            if hi == math.inf or lo == -math.inf:
+                raise ValueError(f"action contains non-finite values: {values}")
             values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
+        # Clipped first, so the sum cannot overflow: it is NaN only if an entry is.
+        if math.isnan(sum(values)):
+            raise ValueError(f"action contains non-finite values: {values}")
         use_torque = self.use_torque
         per = 6 if use_torque else 3
         gx, gy, gz = self._gravity
@@ -430,7 +525,7 @@ class SGCEnv(gym.Env):
         drives: list[Drive] = []
         applied_f: list[float] = []
         applied_t: list[float] = []
-        for i, (pos, _, lin, _) in enumerate(self._states):
+        for i, (pos, orn, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
             fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
@@ -438,8 +533,8 @@ class SGCEnv(gym.Env):
             applied_f += f
             tq = None
             if use_torque:
-                tl = self._tlimit[i]
-                tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
+                sx, sy, sz = self._tscale[i]
+                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
@@ -454,9 +549,9 @@ class SGCEnv(gym.Env):
         moves: list[list[tuple[int, tuple[float, float, float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
-            last = len(self._prop_table) - 1  # props hold still if stepped past truncation
+            at = self._props.at
             moves = [
-                list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
+                list(zip(self._prop_uids, at(base + k + 1), strict=True))
                 for k in range(self.substeps)
             ]
         self.sim.step_bodies(drives, moves)
@@ -469,8 +564,9 @@ class SGCEnv(gym.Env):
             events, changed = task.advance(self._tick)
             if changed:
                 self._observe(read=False)
-        reward = task.reward_function(task, values, events)
         terminated = self._failed
+        steps_left = self.max_steps - self._tick
+        reward = task.reward_function(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":
@@ -512,11 +608,29 @@ class SGCEnv(gym.Env):
         self.task.restore(task_counters, self._tick)
 
     def save_state(self) -> SavedState:
-        """Snapshot physics (PyBullet saveState, in memory) and the env's goal counters."""
-        return SavedState(self.sim.save_state(), self._counters())
+        """Snapshot physics (PyBullet saveState, in memory, ~100 KB) and the goal counters.
+
+        The PyBullet copy is freed by :meth:`SavedState.free` (or :meth:`free_state`), when the
+        snapshot is garbage-collected, or when the env closes, whichever comes first.
+        """
+        self._check_open()
+        state = SavedState(self.sim.save_state(), self._counters())
+        object.__setattr__(
+            state,
+            "_release",
+            weakref.finalize(state, _remove_state, weakref.ref(self.sim), state.bullet_state),
+        )
+        return state
+
+    def free_state(self, state: SavedState) -> None:
+        """Free a snapshot's PyBullet copy now (restoring it afterwards is an error)."""
+        state.free()
 
     def restore_state(self, state: SavedState) -> np.ndarray:
         """Return to a :meth:`save_state` snapshot; returns the observation there."""
+        self._check_open()
+        if not state.alive:
+            raise ValueError("this saved state was freed (SavedState.free); save a new one")
         self.sim.restore_state(state.bullet_state)
         self._apply_counters(state.counters)
         self._observe()
@@ -534,6 +648,7 @@ class SGCEnv(gym.Env):
         the body's velocities at once, as an impact would. Policies see the push in the
         returned observation, which replaces the one from the last step.
         """
+        self._check_open()
         i = self.scenario.body_index(body) if isinstance(body, str) else int(body)
         if not 0 <= i < self._n:
             raise ValueError(f"body: no body {body!r} in a scene of {self._n}")
@@ -550,6 +665,7 @@ class SGCEnv(gym.Env):
         return self._obs
 
     def __getstate__(self) -> dict[str, Any]:
+        self._check_open()
         return {
             "init_kwargs": self._init_kwargs,
             "counters": self._counters(),
@@ -570,6 +686,7 @@ class SGCEnv(gym.Env):
     # ---------------------------------------------------------------- rendering
 
     def render(self) -> np.ndarray | None:
+        self._check_open()
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
             return None
@@ -582,7 +699,13 @@ class SGCEnv(gym.Env):
         return None
 
     def close(self) -> None:
-        if getattr(self, "sim", None) is not None:
-            self.sim.close()
-            self.sim = None  # type: ignore[assignment]
+        """Disconnect the PyBullet client (saved states go with it). Idempotent."""
+        sim = getattr(self, "sim", None)
+        if sim is not None:
+            sim.close()
+        self._closed = True
         super().close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError("this SGCEnv is closed (close() was called); make a new env")

@@ -25,6 +25,7 @@ from sgc_env.paper import quaternion
 
 __all__ = [
     "MAX_COURSE_ROTATION",
+    "MAX_RELATIVE_ROTATION",
     "angular_acceleration",
     "course_pieces",
     "angular_velocity",
@@ -49,10 +50,18 @@ one axis. Planner and env therefore split a somersault into equal sub-rotations 
 same axis, each one a course of its own (:func:`split_rotation`, one splitter for both).
 """
 
+MAX_RELATIVE_ROTATION = 64.0 * math.pi
+"""Longest relative rotation of one goal (32 turns, 96 courses): bounds the planner's work."""
+
 
 def course_pieces(rotation_vector: ArrayLike) -> int:
     """How many equal courses a relative rotation is split into (see MAX_COURSE_ROTATION)."""
     angle = float(np.linalg.norm(np.asarray(rotation_vector, dtype=float)))
+    if not angle <= MAX_RELATIVE_ROTATION:
+        raise ValueError(
+            f"relative rotation of {angle:.6g} rad is longer than {MAX_RELATIVE_ROTATION:.6g} "
+            "rad (32 turns), the most one goal may ask"
+        )
     return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
 
 
@@ -73,7 +82,10 @@ def split_rotation(
     Without it they are spaced evenly in continuous time; the last ends exactly at ``t1``.
     """
     rel = tuple(float(c) for c in rotation_vector)
-    m = course_pieces(rel)
+    try:
+        m = course_pieces(rel)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
     step = (rel[0] / m, rel[1] / m, rel[2] / m)
     if control_frequency is None:
         return [(step, t1 if i == m else t0 + (t1 - t0) * i / m) for i in range(1, m + 1)]
