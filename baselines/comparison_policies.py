@@ -24,10 +24,11 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.actuation import BodyObservation, read_body, wrench_for_targets
+from baselines.actuation import wrench_for_targets
 from baselines.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.env_model import EnvModel
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.observation_fields import BodyObservation, read_body
 from sgc_env.metrics import goals_from_scenario
 from sgc_env.paper.orientation import left_jacobian_inverse
 from sgc_env.paper.quaternion import unwrap_rotvec

@@ -13,7 +13,7 @@ from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
-from sgc_env.envs import SGCEnv
+from sgc_env.envs import GoalEvent, SGCEnv, StepInfo
 from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS, float32_residuals
 from sgc_env.scenario import (
     Body,
@@ -251,6 +251,9 @@ def test_goal_ticks_advance_goals_and_report_errors():
         steps += 1
         events += info.get("goal_reached", [])
         assert not terminated
+        assert set(info) - {"goal_reached"} == StepInfo.__required_keys__
+        assert set(info) - StepInfo.__required_keys__ <= StepInfo.__optional_keys__
+    assert all(set(e) == GoalEvent.__required_keys__ for e in events)
     assert steps == 90 + 15  # last goal at 1.5 s, margin 0.25 s, 60 Hz
     assert [e["goal"] for e in events] == [0, 1, 2]
     assert [round(e["time"] * 60) for e in events] == [30, 58, 90]
@@ -360,6 +363,15 @@ def test_goal_env_with_her():
         policy_kwargs={"net_arch": [16]}, seed=0,
     )  # fmt: skip
     model.learn(330)
+    # HER relabels desired goals with achieved ones; every relabelled reward must be the env's
+    # own compute_reward(next achieved, desired), and relabelling must create successes.
+    batch = model.replay_buffer.sample(2000)
+    achieved = batch.next_observations["achieved_goal"].numpy()
+    desired = batch.observations["desired_goal"].numpy()
+    expected = env.unwrapped.compute_reward(achieved, desired, [{}] * len(desired))
+    rewards = batch.rewards.numpy().ravel()
+    np.testing.assert_array_equal(rewards, expected)
+    assert model.num_timesteps == 330 and (rewards == 0.0).any() and (rewards == -1.0).any()
 
 
 def test_close_disconnects():
@@ -399,3 +411,48 @@ def test_one_env_id_check_names_the_field_and_the_ids():
         sgc_env.check_env_id("Nope-v0", "env")
     with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
         sgc_env.check_env_id(3)
+
+
+def test_dense_reward_is_its_documented_formula():
+    """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
+    current course's start deviations, floored at 0.1 m and 0.5 rad)."""
+    env = gym.make("SGCRod-v0")
+    obs, _ = env.reset(seed=3)
+    lay = env.unwrapped.layout
+    rng = np.random.default_rng(0)
+    bonus_ticks = 0
+    for _ in range(150):
+        a = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, info = env.step(a)
+        scale_l = max(np.linalg.norm(obs[lay.body_slice(0, "position_course_start")]), 0.1)
+        scale_a = max(np.linalg.norm(obs[lay.body_slice(0, "orientation_course_start")]), 0.5)
+        expected = -(
+            np.linalg.norm(info["position_deviation"][0]) / scale_l
+            + np.linalg.norm(info["orientation_deviation"][0]) / scale_a
+        ) - 0.01 * np.mean(a.astype(np.float64) ** 2)
+        for ev in info.get("goal_reached", []):
+            bonus_ticks += 1
+            if ev["position_error"] is not None:
+                expected += math.exp(-ev["position_error"] / 0.01)
+            if ev["orientation_error"] is not None:
+                expected += math.exp(-ev["orientation_error"] / 0.02)
+        assert reward == pytest.approx(expected, rel=1e-5, abs=1e-9)
+        if terminated or truncated:
+            break
+    assert bonus_ticks > 0
+    env.close()
+
+
+def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
+    from conftest import closing_every_env
+
+    with closing_every_env() as made:
+        left_open = gym.make("SGCPoint-v0")
+        closed = SGCEnv("point_three_goals")
+        closed.close()
+        client = left_open.unwrapped.sim.client
+        assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert made == [left_open.unwrapped, closed]
+    assert left_open.unwrapped.sim is None
+    assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert close_envs == made  # nested blocks: the autouse fixture saw them too

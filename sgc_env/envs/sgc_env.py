@@ -81,7 +81,7 @@ import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import gymnasium as gym
 import numpy as np
@@ -96,7 +96,7 @@ from sgc_env.simulator import Drive, Simulator
 from .props import PropPaths
 from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction, TaskCounters
 
-__all__ = ["SGCEnv", "SavedState"]
+__all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
@@ -114,6 +114,32 @@ _COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
 _COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
 _COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
 _COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
+
+
+class _StepInfoEveryStep(TypedDict):
+    time: float
+    goal_index: np.ndarray
+    orientation_goal_index: np.ndarray
+    position_deviation: np.ndarray
+    orientation_deviation: np.ndarray
+    time_to_goal: np.ndarray
+    orientation_time_to_goal: np.ndarray
+    body_position: np.ndarray
+    body_orientation: np.ndarray
+    body_velocity: np.ndarray
+    body_angular_velocity: np.ndarray
+    point_position: np.ndarray
+    point_velocity: np.ndarray
+    force: np.ndarray
+    torque: np.ndarray
+    spin_clamped: bool
+
+
+class StepInfo(_StepInfoEveryStep, total=False):
+    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
+    one row per body; ``goal_reached`` only on a tick where goals fall."""
+
+    goal_reached: list[GoalEvent]
 
 
 @dataclass(frozen=True)
@@ -350,7 +376,7 @@ class SGCEnv(gym.Env):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
+    ) -> tuple[np.ndarray, StepInfo]:
         self._check_open()
         options = options or {}
         prepared = None
@@ -439,7 +465,7 @@ class SGCEnv(gym.Env):
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         if self._closed:
             self._check_open()
         a = action if type(action) is np.ndarray else np.asarray(action)
@@ -502,7 +528,7 @@ class SGCEnv(gym.Env):
             events, changed = task.advance(self._tick)
             if changed:
                 self._observe(read=False)
-        reward = task.reward(values, events)
+        reward = task.reward_function(task, values, events)
         terminated = self._failed
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
@@ -510,9 +536,9 @@ class SGCEnv(gym.Env):
             self.render()
         return self._obs, reward, terminated, truncated, info
 
-    def _info(self, events: list[GoalEvent]) -> dict[str, Any]:
+    def _info(self, events: list[GoalEvent]) -> StepInfo:
         block, tail = self._block, self._tail
-        info: dict[str, Any] = {
+        info: StepInfo = {
             "time": self._tick * self.dt,
             "goal_index": self.task.goal_index.copy(),
             "orientation_goal_index": self.task.orientation_goal_index.copy(),

@@ -77,8 +77,8 @@ class RewardFunction(Protocol):
 class DistanceReward:
     """``-mean_b(|D_b| / L_b + |phi_b| / A_b) - effort * mean(a^2)`` plus, per goal met this
     tick, ``exp(-|D| / bonus_length) (+ exp(-|phi| / bonus_angle))``; ``L_b = max(|D_i(0)|,
-    min_length)``, ``A_b = max(|phi_i(0)|, min_angle)`` of the current course (see
-    :meth:`GoalTask.scales`)."""
+    min_length)``, ``A_b = max(|phi_i(0)|, min_angle)`` of the current course; the sum over
+    bodies is :attr:`GoalTask.scaled_deviation`."""
 
     def __init__(
         self, effort: float = 0.01, bonus_length: float = 0.01, bonus_angle: float = 0.02
@@ -90,16 +90,7 @@ class DistanceReward:
     def __call__(
         self, task: GoalTask, action: Sequence[float], events: Sequence[GoalEvent]
     ) -> float:
-        cost = 0.0
-        phis, pscale, oscale = task.phi, task.position_scale, task.orientation_scale
-        has_pos, has_ori = task.has_position, task.has_orientation
-        for i, dev in enumerate(task.deviations):
-            if has_pos[i]:
-                dx, dy, dz = dev[0], dev[1], dev[2]
-                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * pscale[i]
-            if has_ori[i]:
-                phi = phis[i]
-                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * oscale[i]
+        cost = task.scaled_deviation
         reward = -cost / task.n_bodies - self.effort * sum([x * x for x in action]) / len(action)
         for ev in events:
             if ev["position_error"] is not None:
@@ -138,10 +129,12 @@ class GoalTask:
     """Goal tracking of every body of one resolved scenario (see the module docstring).
 
     Per step the env calls :meth:`measure` with the bodies' states, then :meth:`advance` on a
-    tick where a goal falls (:attr:`next_event`), then :meth:`reward`. After :meth:`measure`
-    the public lists hold, per body: :attr:`points` (world position of the tracked point),
-    :attr:`deviations` (D and D', zeros without a position track), :attr:`phi` (unwrapped
-    rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`.
+    tick where a goal falls (:attr:`next_event`), then :attr:`reward_function`. After
+    :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
+    tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
+    (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`;
+    and :attr:`scaled_deviation`, ``sum_b |D_b| / L_b + |phi_b| / A_b`` with the current course's
+    scales (:attr:`position_scale` = 1 / L, :attr:`orientation_scale` = 1 / A).
     """
 
     def __init__(
@@ -176,6 +169,7 @@ class GoalTask:
         self.deviations: list[tuple[float, ...]] = []
         self.position_time_left: list[float] = []
         self.orientation_time_left: list[float] = []
+        self.scaled_deviation = 0.0
         self.time = 0.0
         self.reset()
 
@@ -255,16 +249,19 @@ class GoalTask:
 
     def measure(self, states: Sequence[BodyState], time: float) -> None:
         """Deviations of every body from its current goals at ``time`` (see the class)."""
-        offsets, has_pos, has_ori, phis = (
-            self.offsets,
-            self.has_position,
-            self.has_orientation,
-            self.phi,
+        offsets, nails, phis = self.offsets, self.nails, self.phi
+        has_pos, has_ori = self.has_position, self.has_orientation
+        ptime, otime, goal_q = (
+            self.position_goal_time,
+            self.orientation_goal_time,
+            self.goal_quaternions,
         )
+        pscale, oscale = self.position_scale, self.orientation_scale
         points = []
         deviations = []
         ptls = []
         otls = []
+        cost = 0.0
         for i, (pos, orn, lin, ang) in enumerate(states):
             offset = offsets[i]
             if offset == _ZERO3:
@@ -274,29 +271,32 @@ class GoalTask:
                 p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
             points.append(p)
             if has_pos[i]:
-                nail = self.nails[i]
+                nail = nails[i]
                 wx, wy, wz = ang
+                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
                 deviations.append(
                     (
-                        p[0] - nail[0], p[1] - nail[1], p[2] - nail[2],
-                        lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
-                        lin[2] + wx * r[1] - wy * r[0],
+                        dx, dy, dz, lin[0] + wy * r[2] - wz * r[1],
+                        lin[1] + wz * r[0] - wx * r[2], lin[2] + wx * r[1] - wy * r[0],
                     )
                 )  # fmt: skip
-                ptls.append(self.position_goal_time[i] - time)
+                ptls.append(ptime[i] - time)
+                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * pscale[i]
             else:
                 deviations.append(_ZERO6)
                 ptls.append(0.0)
             if has_ori[i]:
-                q = quat_conj_mul(orn, self.goal_quaternions[i])
-                phis[i] = unwrap_rotvec(rotvec_from_quat(q), phis[i])
-                otls.append(self.orientation_goal_time[i] - time)
+                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, goal_q[i])), phis[i])
+                phis[i] = phi
+                otls.append(otime[i] - time)
+                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * oscale[i]
             else:
                 otls.append(0.0)
         self.points = points
         self.deviations = deviations
         self.position_time_left = ptls
         self.orientation_time_left = otls
+        self.scaled_deviation = cost
         self.time = time
 
     def advance(self, tick: int) -> tuple[list[GoalEvent], bool]:
@@ -352,9 +352,6 @@ class GoalTask:
                 any_changed = True
         self.next_event = self._first_pending_tick(tick)
         return events, any_changed
-
-    def reward(self, action: Sequence[float], events: Sequence[GoalEvent]) -> float:
-        return self.reward_function(self, action, events)
 
     # ---------------------------------------------------------------- goal-conditioned view
 

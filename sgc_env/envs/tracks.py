@@ -1,4 +1,4 @@
-"""Per-body goal tracks compiled from a resolved scenario (the env's "task" data).
+"""Per-body goal tracks compiled from a resolved scenario (the data :mod:`.task` runs on).
 
 A body's goals split into a position track (goals with a nail) and an orientation track
 (goals with an orientation part). Everything the observation needs about the current and next

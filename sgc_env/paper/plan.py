@@ -26,13 +26,21 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
-from sgc_env.paper.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_velocity
+from sgc_env.paper.frames import (
+    C_HIGH,
+    C_LOW,
+    K_MIN,
+    EndVelocity,
+    FrameCourse,
+    course_end_velocity,
+)
 from sgc_env.paper.frames import solve_course_in_frame as _solve_in_frame
 from sgc_env.paper.orientation import (
     angular_acceleration,
@@ -53,7 +61,7 @@ __all__ = [
 ]
 
 
-def _vec(value, size: int, where: str, name: str) -> np.ndarray:
+def _vec(value: ArrayLike, size: int, where: str, name: str) -> np.ndarray:
     a = np.asarray(value, dtype=float)
     if a.shape != (size,):
         raise ValueError(f"{where}: {name} must have shape ({size},), got {a.shape}")
@@ -64,7 +72,7 @@ def _vec(value, size: int, where: str, name: str) -> np.ndarray:
     return a
 
 
-def _quat(value, where: str, name: str) -> Rotation:
+def _quat(value: ArrayLike, where: str, name: str) -> Rotation:
     q = _vec(value, 4, where, name)
     if float(np.linalg.norm(q)) < 1e-12:
         raise ValueError(f"{where}: {name} quaternion has zero norm")
@@ -188,8 +196,15 @@ class BodyPlan:
     """Result of :func:`plan_body`. ``sample(t)`` for ``t >= 0``; ``courses`` diagnostics."""
 
     def __init__(
-        self, initial, orient_goals, goal_rotations, orient_track, pos_goals, pos_track, courses
-    ):
+        self,
+        initial: tuple[np.ndarray, Rotation, np.ndarray, np.ndarray],
+        orient_goals: list[Rotation],
+        goal_rotations: list[Rotation],
+        orient_track: _Track | None,
+        pos_goals: list[tuple[np.ndarray, np.ndarray]],
+        pos_track: _Track | None,
+        courses: list[CourseDiagnostics],
+    ) -> None:
         self._x0 = initial[0]
         self._r0 = initial[1]
         self._v0 = initial[2]
@@ -259,7 +274,12 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
     return out
 
 
-def _orientation_courses(r0, goals, times, control_frequency=None):
+def _orientation_courses(
+    r0: Rotation,
+    goals: Sequence[OrientationGoal],
+    times: Sequence[float],
+    control_frequency: int | None = None,
+) -> tuple[list[tuple[Rotation, np.ndarray, float, int]], list[Rotation]]:
     """(goal rotation, phi at the course start, end time, goal index) per course, and the
     rotation each goal reaches.
 
@@ -288,7 +308,15 @@ def _orientation_courses(r0, goals, times, control_frequency=None):
     return out, reached
 
 
-def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
+def _plan_orientation(
+    r0: Rotation,
+    w0: np.ndarray,
+    goals: Sequence[OrientationGoal],
+    times: Sequence[float],
+    end_w: np.ndarray | None,
+    opts: PlanOptions,
+    diags: list[CourseDiagnostics],
+) -> tuple[list[Rotation], list[Rotation], _Track]:
     pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
@@ -314,7 +342,9 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
     return [goal for goal, _, _, _ in pieces], reached, track
 
 
-def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
+def _diag(
+    track: str, i: int, t0: float, t1: float, course: FrameCourse, info: EndVelocity
+) -> CourseDiagnostics:
     return CourseDiagnostics(
         track,
         i,
@@ -328,7 +358,16 @@ def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
     )
 
 
-def _plan_position(x0, v0, orientation_at, goals, times, end_v, opts, diags):
+def _plan_position(
+    x0: np.ndarray,
+    v0: np.ndarray,
+    orientation_at: Callable[[float], tuple[Rotation, np.ndarray, np.ndarray]],
+    goals: Sequence[PositionGoal],
+    times: Sequence[float],
+    end_v: np.ndarray | None,
+    opts: PlanOptions,
+    diags: list[CourseDiagnostics],
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], _Track]:
     resolved = []
     for i, g in enumerate(goals):
         where = f"position goal {i}"
@@ -375,8 +414,8 @@ def plan_body(
     position_goals: Sequence[PositionGoal],
     orientation_goals: Sequence[OrientationGoal] = (),
     *,
-    end_velocity=None,
-    end_angular_velocity=None,
+    end_velocity: ArrayLike | None = None,
+    end_angular_velocity: ArrayLike | None = None,
     options: PlanOptions | None = None,
 ) -> BodyPlan:
     """Plan one body through its goals (absolute times, the initial state is at ``t = 0``).
