@@ -302,9 +302,10 @@ def test_somersault_is_split_into_courses_tracked_continuously():
 
 
 def test_somersault_without_enough_ticks_is_rejected():
-    with pytest.raises(ValueError, match=r"bodies\[0\].goals\[0\]: the plan needs a spin of 188"):
+    # The scenario's plan check refuses it (a ScenarioError naming the body's goals) ...
+    with pytest.raises(ScenarioError, match=r"bodies\[0\].goals: orientation goal 0: .*3 courses"):
         _somersault_env(2.0 / 60.0)
-    # Without the plan check the env's own course split still refuses it.
+    # ... and without the plan check the env's own course split still does.
     with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
         _somersault_env(2.0 / 60.0, check_plan=False)
 
