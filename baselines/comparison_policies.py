@@ -51,6 +51,7 @@ _TRACKS = ("position", "orientation")
 _MODEL_ATTRIBUTES = (
     "scenario",
     "body_inertia",
+    "torque_scale",
     "layout",
     "sim_frequency",
     "substeps",
@@ -161,15 +162,16 @@ class _StatefulPolicy:
         model, slot = self._models[index], self._slots[index]
         t = tick * model.control_dt
         n = len(model.bodies)
-        forces, torques = np.zeros((n, 3)), np.zeros((n, 3))
+        forces, torques, rotations = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 4))
         for b, body in enumerate(model.bodies):
             obs_b = read_body(model, observation, b)
+            rotations[b] = obs_b.orientation
             displacement, rotation_change, exact = self._targets(slot, b, obs_b, tick, t)
             forces[b], torques[b] = wrench_for_targets(
                 model, body, obs_b, point_displacement=displacement,
                 rotation_change=rotation_change, exact_rotation=exact,
             )  # fmt: skip
-        return model.action_from_wrenches(forces, torques)
+        return model.action_from_wrenches(forces, torques, rotations)
 
     def _new_episode(self, index: int, observation: np.ndarray) -> Any:
         raise NotImplementedError

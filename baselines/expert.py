@@ -109,19 +109,19 @@ class SGCExpert:
         values = observation.tolist()
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError("observation contains non-finite values")
-        forces, torques = [], []
+        forces, torques, rotations = [], [], []
         for fields, body in self._bodies:
-            force, torque = self._body_wrench(fields, body, values)
+            rotation = fields.rotation(values)
+            force, torque = self._body_wrench(fields, body, values, rotation)
             forces.append(force)
             torques.append(torque)
-        return model.action_from_wrenches(forces, torques)
+            rotations.append(rotation)
+        return model.action_from_wrenches(forces, torques, rotations)
 
-    def _body_wrench(self, f: BodyFields, body: BodyModel, o: list[float]) -> tuple[tuple, tuple]:
+    def _body_wrench(
+        self, f: BodyFields, body: BodyModel, o: list[float], rotation: tuple
+    ) -> tuple[tuple, tuple]:
         period = self.model.control_dt
-        a, r = f.orientation
-        x, y, z, w = o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2], o[a + 3] + o[r + 3]
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        rotation = (x / norm, y / norm, z / norm, w / norm)
         omega = f.vec(o, f.angular_velocity)
         # ``exact``: a goal is reached on the next tick, so the rotation must land exactly too
         # (the tracked point moves with it).

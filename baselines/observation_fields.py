@@ -9,6 +9,7 @@ comparison controllers get numpy arrays through :func:`read_body`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,6 +70,13 @@ class BodyFields:
 
     def track(self, name: str) -> TrackFields:
         return self.position_track if name == "position" else self.orientation_track
+
+    def rotation(self, o: list[float]) -> tuple[float, float, float, float]:
+        """The body's unit quaternion (xyzw) in double precision."""
+        a, r = self.orientation
+        x, y, z, w = o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2], o[a + 3] + o[r + 3]
+        norm = math.sqrt(x * x + y * y + z * z + w * w)
+        return (x / norm, y / norm, z / norm, w / norm)
 
     @staticmethod
     def vec(o: list[float], at: tuple[int, int]) -> tuple[float, float, float]:

@@ -28,6 +28,8 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
     "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
+    "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
+    "SGCThreeRodsRandom-v0": (_ENTRY, {"random_scenario": "three_rods"}),
     "SGCPointGoal-v0": ("sgc_env.envs.goal_env:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)

@@ -155,6 +155,30 @@ def test_force_acts_at_centre_of_mass_without_spin():
     assert np.max(np.abs(info["body_angular_velocity"])) < 1e-12
 
 
+@pytest.mark.parametrize("shape", ["rod", "box"])
+def test_unit_torque_action_gives_the_same_angular_acceleration_about_every_body_axis(shape):
+    tilt = (0.2, -0.4, 0.3, 0.8)
+    tilt = tuple(np.divide(tilt, np.linalg.norm(tilt)))
+    body = Body(
+        "b", shape=shape, size=(0.6, 0.03) if shape == "rod" else (0.3, 0.1, 0.02),
+        position=(0.0, 0.0, 1.0), orientation=tilt, goals=(Goal(nail=(1.0, 0.0, 1.0), time=1.0),),
+    )  # fmt: skip
+    env = SGCEnv(Scenario(bodies=(body,), gravity=(0.0, 0.0, 0.0), margin=0.0))
+    inertia = env.body_inertia[0]
+    assert env.torque_scale[0] == pytest.approx(body.torque_limit * inertia / inertia.max())
+    rm = np.array(sgc_env.simulator.pybullet.getMatrixFromQuaternion(tilt)).reshape(3, 3)
+    for axis in range(3):
+        env.reset()
+        action = np.zeros(6)
+        action[3 + axis] = -1.0
+        _, _, _, _, info = env.step(action)
+        omega_body = rm.T @ info["body_angular_velocity"][0]
+        # one substep's rotation changes the axes a little; the first tick is the same for all
+        expected = -body.torque_limit / inertia.max() * env.dt
+        assert omega_body[axis] == pytest.approx(expected, rel=2e-2), (axis, omega_body)
+        assert info["torque"][0] == pytest.approx(rm[:, axis] * -env.torque_scale[0][axis])
+
+
 def test_gravity_is_on_by_default_and_not_compensated():
     s = load_scenario("point_three_goals")
     env = SGCEnv(s)
@@ -302,10 +326,10 @@ def test_somersault_is_split_into_courses_tracked_continuously():
 
 
 def test_somersault_without_enough_ticks_is_rejected():
-    # The scenario's plan check refuses it (a ScenarioError naming the body's goals) ...
-    with pytest.raises(ScenarioError, match=r"bodies\[0\].goals: orientation goal 0: .*3 courses"):
+    # The plan check splits the somersault on the env's ticks too, so it refuses it first.
+    with pytest.raises(ValueError, match=r"bodies\[0\]\.goals.*rotation of 6.28.*3 courses"):
         _somersault_env(2.0 / 60.0)
-    # ... and without the plan check the env's own course split still does.
+    # Without the plan check the env's own course split still refuses it.
     with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
         _somersault_env(2.0 / 60.0, check_plan=False)
 
@@ -354,6 +378,25 @@ def test_goal_env_compute_reward_is_vectorised():
     assert env.compute_reward(a, d, [{}, {}]).tolist() == [0.0, -1.0]
 
 
+def test_goal_env_charges_the_steps_a_failure_leaves():
+    env = gym.make("SGCPointGoal-v0")
+    env.reset(seed=0)
+    base = env.unwrapped
+    terminated = False
+    while not terminated:
+        obs, reward, terminated, truncated, info = env.step(np.ones(3))
+        assert not truncated
+    left = base.max_steps - base._tick
+    assert left > 0 and info["failure_charge"] == left
+    assert reward == -1.0 - left
+    # HER recomputes rewards with the stored infos: the charge survives relabelling
+    goal = obs["achieved_goal"][None]
+    relabelled = base.compute_reward(goal, goal, [info])
+    assert relabelled.tolist() == [-float(left)]
+    with pytest.raises(ValueError, match="reward modes apply to SGCEnv"):
+        gym.make("SGCPointGoal-v0", reward="sparse")
+
+
 def test_goal_env_with_her():
     from stable_baselines3 import SAC, HerReplayBuffer
 
@@ -371,7 +414,11 @@ def test_goal_env_with_her():
     desired = batch.observations["desired_goal"].numpy()
     expected = env.unwrapped.compute_reward(achieved, desired, [{}] * len(desired))
     rewards = batch.rewards.numpy().ravel()
-    np.testing.assert_array_equal(rewards, expected)
+    # A failure's transition also carries the charge for the steps it left (its stored info's
+    # failure_charge, which the empty infos here do not have); those are terminal.
+    charged = rewards < -1.0
+    np.testing.assert_array_equal(rewards[~charged], expected[~charged])
+    assert (batch.dones.numpy().ravel()[charged] == 1.0).all()
     assert model.num_timesteps == 330 and (rewards == 0.0).any() and (rewards == -1.0).any()
 
 
@@ -383,7 +430,7 @@ def test_close_disconnects():
 
 
 def test_spin_clamp_is_flagged_not_terminal():
-    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), shape="rod"))
+    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 98.9), shape="rod"))
     env.reset()
     _, _, terminated, _, info = env.step(np.array([0, 0, 0, 0, 0, 1], np.float32))
     assert info["spin_clamped"] and not terminated
@@ -416,8 +463,8 @@ def test_one_env_id_check_names_the_field_and_the_ids():
 
 def test_dense_reward_is_its_documented_formula():
     """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
-    current course's start deviations, floored at 0.1 m and 0.5 rad)."""
-    env = gym.make("SGCRod-v0")
+    current course's start deviations, floored at 0.1 m and 0.5 rad): the "distance" mode."""
+    env = gym.make("SGCRod-v0", reward="distance")
     obs, _ = env.reset(seed=3)
     lay = env.unwrapped.layout
     rng = np.random.default_rng(0)
@@ -454,6 +501,6 @@ def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
         client = left_open.unwrapped.sim.client
         assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert made == [left_open.unwrapped, closed]
-    assert left_open.unwrapped.sim is None
+    assert left_open.unwrapped._closed
     assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert close_envs == made  # nested blocks: the autouse fixture saw them too

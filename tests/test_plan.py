@@ -337,3 +337,27 @@ def test_somersault_on_the_control_grid_splits_as_the_env_does():
     assert [round(t * 60) for t in ends] == [25, 49, 74, 98, 123]
     even = plan_body(_state(), [], [OrientationGoal(2.05, relative_rotation=rel)])
     assert [c.t_end for c in even.courses] != ends  # continuous time: 0.41, 0.82, ...
+
+
+def test_vectorised_deviations_match_the_samples():
+    """BodyPlan.deviations (one vectorised evaluation per course) agrees with sample()."""
+    plan, pos, _ = _rod_plan()
+    times = np.array([0.05, 0.7, 0.71, 1.5, 2.1, 2.9, 3.0, 3.4])
+    d, v, a = plan.deviations(times, "position")
+    nails = np.array([pos[min(np.searchsorted([g.time for g in pos], t), 3)].nail for t in times])
+    for k, t in enumerate(times):
+        s = plan.sample(float(t))
+        np.testing.assert_allclose(d[k] + nails[k], s.point_position, atol=1e-12)
+        np.testing.assert_allclose(v[k], s.point_velocity, atol=1e-12)
+    h = 1e-6  # D'' is the derivative of D' (inside courses)
+    for t in (0.3, 1.0, 2.5):
+        (v0, v1), acc = plan.deviations(np.array([t - h, t + h]))[1], plan.deviations([t])[2][0]
+        np.testing.assert_allclose((v1 - v0) / (2 * h), acc, atol=1e-4)
+    # at an orientation goal phi = 0, so J_l = I and omega = phi'
+    goal_times = np.array([1.0, 2.0, 3.0])
+    phi, phi_dot, _ = plan.deviations(goal_times, "orientation")
+    np.testing.assert_allclose(phi, 0.0, atol=1e-12)
+    for k, t in enumerate(goal_times):
+        np.testing.assert_allclose(phi_dot[k], plan.sample(float(t)).angular_velocity, atol=1e-12)
+    with pytest.raises(ValueError, match="track must be"):
+        plan.deviations(times, "spin")

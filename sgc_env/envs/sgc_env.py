@@ -8,12 +8,19 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz in the world frame,
-scaled by the body's ``force_limit`` (N) and ``torque_limit`` (N m). When every body is a
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
+``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
+``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
+that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
+axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
+start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
+its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
+1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
+orientation goal; scaled body axes make every axis equally sensitive. When every body is a
 sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
 the centre of mass; gravity is *not* compensated. The action is held for one control period
 (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep.
+every substep (the world torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -40,17 +47,38 @@ reaches t_i already describes goal i+1.
 
 ## Rewards
 
-``r = -mean_b(|D_b| / L_b + |phi_b| / A_b) - 0.01 * mean(a^2) + sum over goals met this tick of
-exp(-|D| / 0.01 m) (+ exp(-|phi| / 0.02 rad))``, with ``L_b = max(|D_i(0)|, 0.1 m)`` and
-``A_b = max(|phi_i(0)|, 0.5 rad)`` of the current course. Dense, bounded by the bonus.
+``reward=`` (constructor, ``gym.make(id, reward=...)``) picks one of three modes
+(:mod:`sgc_env.envs.rewards` has the code; ``D`` the tracked point's deviation, ``D_i(0)`` and
+``T_i`` the current course's start deviation and duration, ``L = max(|D_i(0)|, 0.1 m)``; the
+same for orientation with ``phi`` and ``A = max(|phi_i(0)|, 0.5 rad)``; ``bonus`` = per goal met
+this tick ``exp(-|D| / 0.01 m)`` (+ ``exp(-|phi| / 0.02 rad)``); means over bodies):
+
+- ``"schedule"`` (default): ``r = -mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2)
+  + bonus`` with ``D_sched = D_i(0) time_left / T_i`` (after the last goal ``-v_end
+  time_left``, carrying on at the end velocity). ``D_sched`` is the paper's behaviour equation
+  ``D'' - 2a D' + (a^2 + b^2) D = 0``, ``D(T) = 0``, ``D'(T) = -k D0 / T`` in its neutral member
+  (``k = 1``, ``a = b = 0``): the course travelled on schedule. It depends only on the course
+  and the clock, so the cost vanishes only where the body should be *now*: reaching the nail
+  early and hovering costs ``time_left / T_i`` per step, as does arriving late, and the bonus
+  pays for exactness on the tick; the SGC expert departs from it only by its smooth course
+  starts and earns close to the maximum.
+- ``"distance"`` (the reward before the modes): ``r = -mean_b(|D| / L + |phi| / A) - 0.01
+  mean(a^2) + bonus``. It pays for reaching the nail early and hovering, and ranks the early,
+  inexact dynamic-constraints controller above the expert; kept for comparison.
+- ``"sparse"``: ``r = -0.01 mean(a^2) + bonus``.
+
+A failure (``terminated``) under ``schedule`` and ``sparse`` also charges every step the episode
+had left at the mode's worst per-step reward (``mean_b(tracks) + 0.01``, resp. ``0.01``; the
+per-track cost is capped at 1 for this), so leaving the workspace never ends a negative stream
+early; ``distance`` charges nothing, as before. An unknown mode is a ``ValueError`` naming the
+choices.
 
 ## Episode end
 
 ``truncated`` at the last goal time + ``scenario.margin`` (reaching a goal never ends an
 episode). ``terminated`` on failure: non-finite state, a body CoM outside the workspace box, or
-a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s; a
-thin rod's axial spin reaches that within a step under random torques, so it is not terminal:
-``info["spin_clamped"]`` flags it (the physics is then no longer exact).
+a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s;
+that is not terminal: ``info["spin_clamped"]`` flags it (the physics is then no longer exact).
 
 ## Info
 
@@ -63,12 +91,13 @@ goal orientation, in [0, pi], at that tick; None for a missing part).
 
 ## Arguments
 
-``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
-:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
-reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
-an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
+``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
+(240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
-distance, yaw, pitch, target, width, height). ``reset(options={"scenario": ...})`` swaps the
+distance, yaw, pitch, target, width, height), ``reward`` (``"schedule"``, ``"distance"`` or
+``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
 plain reset).
 """
@@ -79,7 +108,7 @@ import math
 import struct
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, TypedDict
 
@@ -87,14 +116,16 @@ import gymnasium as gym
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.paper.quaternion import rotate
+from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.simulator import Drive, Simulator
 
 from .props import PropPaths
-from .task import DistanceReward, GoalEvent, GoalTask, RewardFunction, TaskCounters
+from .rewards import make_reward
+from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
 
 __all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
@@ -205,18 +236,22 @@ class SGCEnv(gym.Env):
         self,
         scenario: Scenario | str | Path | None = None,
         *,
-        random_scenario: RandomScenarioConfig | str | None = None,
+        random_scenario: SceneFamily | str | None = None,
         control_frequency: int | None = None,
         sim_frequency: int = 240,
         time_grid: str | None = None,
         render_mode: str | None = None,
         camera: dict[str, Any] | None = None,
+        reward: str = "schedule",
     ) -> None:
         self._init_kwargs = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
+            "reward": reward,
         }  # fmt: skip
+        self.reward_mode = reward
+        self._reward: RewardFunction = make_reward(reward)
         if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
             raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
         if scenario is None and random_scenario is None:
@@ -225,13 +260,11 @@ class SGCEnv(gym.Env):
             )
         self.render_mode = render_mode
         self.camera = CameraConfig.from_dict(camera)
-        self._random_config: RandomScenarioConfig | None = None
+        self._random_config: SceneFamily | None = None
         if scenario is None:
             cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
             if control_frequency is not None:
-                cfg = RandomScenarioConfig(
-                    **{**cfg.__dict__, "control_frequency": control_frequency}
-                )
+                cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
@@ -272,7 +305,6 @@ class SGCEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
-        self._reward: RewardFunction = DistanceReward()
         self._markers: NailMarkers | None = None
         self._closed = False
         self.scenario: Scenario = base
@@ -364,7 +396,11 @@ class SGCEnv(gym.Env):
         self._props = prepared.props
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
-        self._tlimit = [float(b.torque_limit) for b in s.bodies]
+        self.torque_scale = np.array(
+            [float(b.torque_limit) * inertia / inertia.max()
+             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        )  # fmt: skip
+        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
@@ -489,7 +525,7 @@ class SGCEnv(gym.Env):
         drives: list[Drive] = []
         applied_f: list[float] = []
         applied_t: list[float] = []
-        for i, (pos, _, lin, _) in enumerate(self._states):
+        for i, (pos, orn, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
             fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
@@ -497,8 +533,8 @@ class SGCEnv(gym.Env):
             applied_f += f
             tq = None
             if use_torque:
-                tl = self._tlimit[i]
-                tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
+                sx, sy, sz = self._tscale[i]
+                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
@@ -528,8 +564,9 @@ class SGCEnv(gym.Env):
             events, changed = task.advance(self._tick)
             if changed:
                 self._observe(read=False)
-        reward = task.reward_function(task, values, events)
         terminated = self._failed
+        steps_left = self.max_steps - self._tick
+        reward = task.reward_function(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":

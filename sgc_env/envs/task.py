@@ -26,11 +26,11 @@ from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
 from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
 
+from .rewards import DistanceReward
 from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
     "BodyState",
-    "DistanceReward",
     "GoalEvent",
     "GoalTask",
     "RewardFunction",
@@ -67,37 +67,18 @@ class TaskCounters(TypedDict):
 
 class RewardFunction(Protocol):
     """The reward of one control step, from the task after the step (its deviations, current
-    courses and tracks), the clipped action values and the goal events of the step."""
+    courses and tracks), the clipped action values and the goal events of the step; on a failure
+    (``terminated``) also the number of steps the episode had left, so a mode can charge them
+    (the modes, :class:`DistanceReward` among them: :mod:`sgc_env.envs.rewards`)."""
 
     def __call__(
-        self, task: GoalTask, action: Sequence[float], events: Sequence[GoalEvent]
+        self,
+        task: GoalTask,
+        action: Sequence[float],
+        events: Sequence[GoalEvent],
+        terminated: bool = False,
+        steps_left: int = 0,
     ) -> float: ...
-
-
-class DistanceReward:
-    """``-mean_b(|D_b| / L_b + |phi_b| / A_b) - effort * mean(a^2)`` plus, per goal met this
-    tick, ``exp(-|D| / bonus_length) (+ exp(-|phi| / bonus_angle))``; ``L_b = max(|D_i(0)|,
-    min_length)``, ``A_b = max(|phi_i(0)|, min_angle)`` of the current course; the sum over
-    bodies is :attr:`GoalTask.scaled_deviation`."""
-
-    def __init__(
-        self, effort: float = 0.01, bonus_length: float = 0.01, bonus_angle: float = 0.02
-    ) -> None:
-        self.effort = effort
-        self.bonus_length = bonus_length
-        self.bonus_angle = bonus_angle
-
-    def __call__(
-        self, task: GoalTask, action: Sequence[float], events: Sequence[GoalEvent]
-    ) -> float:
-        cost = task.scaled_deviation
-        reward = -cost / task.n_bodies - self.effort * sum([x * x for x in action]) / len(action)
-        for ev in events:
-            if ev["position_error"] is not None:
-                reward += math.exp(-ev["position_error"] / self.bonus_length)
-            if ev["orientation_error"] is not None:
-                reward += math.exp(-ev["orientation_error"] / self.bonus_angle)
-        return reward
 
 
 def rotation_angle(phi: Sequence[float]) -> float:

@@ -231,6 +231,33 @@ class BodyPlan:
         omega = left_jacobian(phi) @ phi_dot
         return rot, omega, angular_acceleration(phi, phi_dot, phi_ddot)
 
+    def deviations(
+        self, t: np.ndarray, track: str = "position"
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Planned ``(D, D', D'')`` of one track at an array of times, each ``t.shape + (3,)``:
+        the tracked point's deviation from its nail (``"position"``, world frame) or ``phi``
+        (``"orientation"``). One vectorised evaluation per course, where ``sample`` costs
+        about 0.5 ms a call: what a feasibility check on every reset can afford. A course owns
+        ``(t_start, t_end]``; after the track's last goal the deviation moves on with the
+        track's end velocity; zeros for a body without that track.
+        """
+        if track not in ("position", "orientation"):
+            raise ValueError(f"track must be 'position' or 'orientation', got {track!r}")
+        tr = self._pos if track == "position" else self._orient
+        t = np.asarray(t, float)
+        d, v, a = (np.zeros(t.shape + (3,)) for _ in range(3))
+        if tr is None:
+            return d, v, a
+        index = np.searchsorted(tr.ends, t, side="left")
+        for i, course in enumerate(tr.courses):
+            mask = index == i
+            if mask.any():
+                d[mask], v[mask], a[mask] = course.evaluate(t[mask] - tr.starts[i])
+        after = index == len(tr.courses)
+        v[after] = tr.end_velocity
+        d[after] = np.multiply.outer(t[after] - tr.ends[-1], tr.end_velocity)
+        return d, v, a
+
     def sample(self, t: float) -> PlanSample:
         """Planned state at absolute time ``t`` (seconds, ``t >= 0``)."""
         t = float(t)

@@ -33,6 +33,7 @@ __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table"
 SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("env_id", "env", "s"),
     ("policy", "policy", "s"),
+    ("return_mean", "return", ".1f"),
     ("success_rate", "success", ".2f"),
     ("position_error_max", "pos err max (m)", ".1e"),
     ("orientation_error_max", "ori err max (rad)", ".1e"),
@@ -77,6 +78,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="success time tolerance (default: one control step)",
     )  # fmt: skip
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    parser.add_argument(
+        "--reward", default=None, metavar="MODE",
+        help="the env's reward mode (gym.make(id, reward=MODE): schedule, distance, sparse); "
+        "default: the env's own",
+    )  # fmt: skip
 
 
 def _split(values: Sequence[str] | None, default: str) -> list[str]:
@@ -203,8 +209,10 @@ def run(args: argparse.Namespace) -> int:
                 folder = Path() if single else Path(env_id) / label
                 try:
                     result = evaluate(
-                        spec, env_id, args.episodes, args.seed, tolerances=tolerances, label=label
-                    )
+                        spec, env_id, args.episodes, args.seed, tolerances=tolerances,
+                        label=label,
+                        env_kwargs=None if args.reward is None else {"reward": args.reward},
+                    )  # fmt: skip
                 except ValueError as exc:
                     print(f"sgc evaluate: error: {exc}", file=sys.stderr)
                     return 2
