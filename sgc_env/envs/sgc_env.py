@@ -708,6 +708,7 @@ class SGCEnv(gym.Env):
         sim = getattr(self, "sim", None)
         if sim is not None:
             sim.close()
+            self.sim = None  # type: ignore[assignment]
         self._closed = True
         super().close()
 
