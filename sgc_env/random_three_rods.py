@@ -172,7 +172,7 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
         if not _enters_board(body, cfg.min_entry_cosine):
             continue
         body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
-        scenario = resolve_scenario(scenario_from_dict(data))
+        scenario = resolve_scenario(scenario_from_dict(data), check_plan=False)
         ((force, torque),) = planner_demand(scenario)
         if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
             return scenario
