@@ -175,9 +175,11 @@ def planner_demand(scenario: Scenario, samples: int = 120) -> list[tuple[float, 
     """Peak |force| and |torque| per body along the analytic SGC plan (``sgc_env.paper.plan``).
 
     Force = m (a - g); torque bounded by I_max |alpha| + I_max |omega|^2 (gyroscopic term). The
-    torque action about body axis k is (I_k alpha_k + gyro_k) / (torque_limit I_k / I_max), and
-    |gyro_k| <= I_k |omega|^2 (principal moments obey I_k >= |I_j - I_l|), so the same bound
-    below ``torque_limit`` keeps every axis of the scaled torque action below 1.
+    torque action ``R0 diag(1 / torque_scale) R0^T tau`` has principal components
+    (I_k alpha_k + gyro_k) / (torque_limit I_k / I_max), and |gyro_k| <= I_k |omega_j omega_l|
+    (principal moments obey I_k >= |I_j - I_l|), so its norm, and every entry, stays below
+    (I_max |alpha| + I_max |omega|^2) / torque_limit: the same bound below ``torque_limit``
+    keeps the scaled torque action inside the box.
     Costly (milliseconds), so the env does not call it on every reset; tests use it to show
     that the limits from the geometric bound cover what the plan needs.
     """
