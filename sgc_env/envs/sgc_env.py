@@ -8,19 +8,21 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
-``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
-``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
-that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
-axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
-start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
-its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
-1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
-orientation goal; scaled body axes make every axis equally sensitive. When every body is a
-sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
-the centre of mass; gravity is *not* compensated. The action is held for one control period
-(``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep (the world torque too: it is fixed at the step's start).
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz, both in the world frame.
+The force is scaled by the body's ``force_limit`` (N). The torque is scaled per principal axis,
+``tau = R0 diag(torque_scale) R0^T a`` with ``torque_scale = torque_limit * I / max(I)`` (N m;
+``env.torque_scale``, one row per body) and ``R0`` the body's orientation at the start of the
+control step: a torque action is an angular-acceleration command, and an action of 1 along
+any direction gives the same angular acceleration ``torque_limit / max(I)`` (gyroscopic terms
+aside). Why: a thin rod's axial inertia is ~70 times smaller than its transverse one, so with a
+plain world-frame torque box an action error of 1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its
+axis and no learned policy met a rod orientation goal. Why world axes rather than body axes:
+body-axis actions make the policy rotate its world-frame observation (phi, omega) into the
+body frame, and a clone trained on them spun the rod up (1/150 goals, docs/agents.md). When
+every body is a sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``.
+The force acts at the centre of mass; gravity is *not* compensated. The action is held for one
+control period (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default)
+and re-applied on every substep (the torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -117,7 +119,7 @@ import numpy as np
 
 from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.paper.quaternion import rotate
+from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
@@ -539,7 +541,8 @@ class SGCEnv(gym.Env):
             tq = None
             if use_torque:
                 sx, sy, sz = self._tscale[i]
-                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
+                bx, by, bz = rotate_back(orn, (values[o + 3], values[o + 4], values[o + 5]))
+                tq = rotate(orn, (bx * sx, by * sy, bz * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
