@@ -24,12 +24,14 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.actuation import BodyObservation, read_body, wrench_for_targets
+from baselines.actuation import wrench_for_targets
 from baselines.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.env_model import EnvModel
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.observation_fields import BodyObservation, read_body
 from sgc_env.metrics import goals_from_scenario
 from sgc_env.paper.orientation import left_jacobian_inverse
+from sgc_env.paper.quaternion import unwrap_rotvec
 from sgc_env.scenario import Scenario
 
 __all__ = [
@@ -49,6 +51,7 @@ _TRACKS = ("position", "orientation")
 _MODEL_ATTRIBUTES = (
     "scenario",
     "body_inertia",
+    "torque_scale",
     "layout",
     "sim_frequency",
     "substeps",
@@ -159,15 +162,16 @@ class _StatefulPolicy:
         model, slot = self._models[index], self._slots[index]
         t = tick * model.control_dt
         n = len(model.bodies)
-        forces, torques = np.zeros((n, 3)), np.zeros((n, 3))
+        forces, torques, rotations = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 4))
         for b, body in enumerate(model.bodies):
             obs_b = read_body(model, observation, b)
+            rotations[b] = obs_b.orientation
             displacement, rotation_change, exact = self._targets(slot, b, obs_b, tick, t)
             forces[b], torques[b] = wrench_for_targets(
                 model, body, obs_b, point_displacement=displacement,
                 rotation_change=rotation_change, exact_rotation=exact,
             )  # fmt: skip
-        return model.action_from_wrenches(forces, torques)
+        return model.action_from_wrenches(forces, torques, rotations)
 
     def _new_episode(self, index: int, observation: np.ndarray) -> Any:
         raise NotImplementedError
@@ -219,13 +223,7 @@ def _compose(phi: np.ndarray, start: np.ndarray) -> np.ndarray:
     goals, as the observation gives it), R = Exp(phi') R_j.
     """
     principal = (Rotation.from_rotvec(phi) * Rotation.from_rotvec(start)).as_rotvec()
-    reference = phi + start
-    angle = float(np.linalg.norm(principal))
-    if angle < 1e-12:
-        return principal
-    axis = principal / angle
-    turns = round((axis @ reference - angle) / (2.0 * np.pi))
-    return axis * (angle + 2.0 * np.pi * turns)
+    return np.array(unwrap_rotvec(principal, phi + start))
 
 
 class DynamicConstraintsController(_StatefulPolicy):

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from sgc_env.observation import ObservationLayout
+from sgc_env.paper import quaternion as quat
 
 __all__ = ["BodyModel", "EnvModel"]
 
@@ -25,6 +26,8 @@ class BodyModel:
     inertia: tuple[float, float, float]
     force_limit: float
     torque_limit: float
+    torque_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    """N m per unit of torque action about each principal axis (``env.torque_scale``)."""
 
 
 @dataclass(frozen=True)
@@ -53,8 +56,11 @@ class EnvModel:
                 inertia=tuple(float(x) for x in inertia),  # type: ignore[arg-type]
                 force_limit=float(b.force_limit),
                 torque_limit=float(b.torque_limit),
+                torque_scale=tuple(float(x) for x in scale),  # type: ignore[arg-type]
             )
-            for b, inertia in zip(scenario.bodies, base.body_inertia, strict=True)
+            for b, inertia, scale in zip(
+                scenario.bodies, base.body_inertia, base.torque_scale, strict=True
+            )
         )
         return cls(
             layout=base.layout,
@@ -65,28 +71,35 @@ class EnvModel:
             use_torque=bool(base.use_torque),
         )
 
-    def action_from_wrenches(self, forces, torques) -> np.ndarray:
+    def action_from_wrenches(self, forces, torques, orientations) -> np.ndarray:
         """Normalised, clipped action from world forces (N) and torques (N m), one per body.
 
         ``forces`` and ``torques``: arrays of shape (n, 3) or sequences of 3-tuples (the
-        expert passes tuples; plain floats keep its control step cheap). The action is float64
-        on purpose: rounding it to the float32 of the action space moves a thin rod's
-        orientation at a goal by up to ~1e-9 rad (its axial inertia amplifies the rounding of
-        the world torque), and the env uses whatever precision it is given.
+        expert passes tuples; plain floats keep its control step cheap). ``orientations``:
+        each body's quaternion (xyzw) at the start of the step, which the env uses to turn the
+        body-axis torque action into a world torque (``R0 (torque_scale * a)``); here the
+        inverse, ``R0^T tau / torque_scale``, so the env applies exactly ``tau``. The action is
+        float64 on purpose: the env uses whatever precision it is given, and rounding the torque
+        to the float32 of the action space moved a thin rod's orientation at a goal by up to
+        ~1e-9 rad under world-frame torques.
         """
         n = len(self.bodies)
         if isinstance(forces, np.ndarray):
             forces = forces.reshape(n, 3).tolist()
         if isinstance(torques, np.ndarray):
             torques = torques.reshape(n, 3).tolist()
+        if isinstance(orientations, np.ndarray):
+            orientations = orientations.reshape(n, 4).tolist()
         out: list[float] = []
         use_torque = self.use_torque
-        for body, (fx, fy, fz), (tx, ty, tz) in zip(self.bodies, forces, torques, strict=True):
+        for body, force, torque, q in zip(self.bodies, forces, torques, orientations, strict=True):
             f_lim = body.force_limit
-            out += (fx / f_lim, fy / f_lim, fz / f_lim)
+            out += (force[0] / f_lim, force[1] / f_lim, force[2] / f_lim)
             if use_torque:
-                t_lim = body.torque_limit
-                out += (tx / t_lim, ty / t_lim, tz / t_lim)
+                sx, sy, sz = body.torque_scale
+                x, y, z, w = q
+                bx, by, bz = quat.rotate((-x, -y, -z, w), torque)
+                out += (bx / sx, by / sy, bz / sz)
         return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
 
 

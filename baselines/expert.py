@@ -20,7 +20,7 @@ import numpy as np
 
 from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
-from sgc_env.observation import ObservationLayout
+from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
@@ -66,7 +66,7 @@ class SGCExpert:
         self.model = model
         self.refine = refine
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
-        self._bodies: tuple[_BodyFields, ...] = ()
+        self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
         self._courses: dict[tuple[float, ...], tuple[tuple, tuple]] = {}
 
     def predict(
@@ -103,25 +103,25 @@ class SGCExpert:
             )
         if self._fields_of is not model:  # built lazily: ``model`` may be reassigned
             self._bodies = tuple(
-                _BodyFields(model.layout, i, body) for i, body in enumerate(model.bodies)
+                (BodyFields(model.layout, i), body) for i, body in enumerate(model.bodies)
             )
             self._fields_of = model
         values = observation.tolist()
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError("observation contains non-finite values")
-        forces, torques = [], []
-        for fields in self._bodies:
-            force, torque = self._body_wrench(fields, values)
+        forces, torques, rotations = [], [], []
+        for fields, body in self._bodies:
+            rotation = fields.rotation(values)
+            force, torque = self._body_wrench(fields, body, values, rotation)
             forces.append(force)
             torques.append(torque)
-        return model.action_from_wrenches(forces, torques)
+            rotations.append(rotation)
+        return model.action_from_wrenches(forces, torques, rotations)
 
-    def _body_wrench(self, f: _BodyFields, o: list[float]) -> tuple[tuple, tuple]:
+    def _body_wrench(
+        self, f: BodyFields, body: BodyModel, o: list[float], rotation: tuple
+    ) -> tuple[tuple, tuple]:
         period = self.model.control_dt
-        a, r = f.orientation
-        x, y, z, w = o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2], o[a + 3] + o[r + 3]
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        rotation = (x / norm, y / norm, z / norm, w / norm)
         omega = f.vec(o, f.angular_velocity)
         # ``exact``: a goal is reached on the next tick, so the rotation must land exactly too
         # (the tracked point moves with it).
@@ -153,14 +153,14 @@ class SGCExpert:
                 deviation_next[2] - deviation[2],
             )
         return body_wrench(
-            self.model, f.body, rotation, omega, f.vec(o, f.linear_velocity),
+            self.model, body, rotation, omega, f.vec(o, f.linear_velocity),
             f.vec(o, f.point_offset), displacement, rotation_change,
             exact_rotation=exact, refine=self.refine,
         )  # fmt: skip
 
-    def _next_deviation(self, o, track: _TrackFields, deviation, rate, time_left, period):
+    def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
         """The re-solved rest of the current course, one control period ahead."""
-        key = tuple(o[track.course : track.course + _COURSE_SIZE])
+        key = tuple(o[track.course : track.course + COURSE_SIZE])
         course = self._courses.get(key)
         if course is None:
             course = _course_constants(key)
@@ -169,13 +169,6 @@ class SGCExpert:
             self._courses[key] = course
         end_velocity, rows = course
         return next_deviation(rows, deviation, rate, time_left, end_velocity, period)
-
-
-_COURSE_FIELDS = ("course_start", "course_duration", "next_start", "next_duration",
-                  "end_velocity", "flags")  # fmt: skip
-_COURSE_LAYOUT = [(0, 3), (3, 4), (4, 7), (7, 8), (8, 11), (11, 13)]
-_COURSE_SIZE = 13
-"""The course constants are contiguous in a body block: 3 + 1 + 3 + 1 + 3 + 2 entries."""
 
 
 def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
@@ -190,52 +183,3 @@ def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
     )  # fmt: skip
     rows = _IDENTITY_ROWS if info.frame is None else tuple(map(tuple, info.frame.tolist()))
     return tuple(velocity.tolist()), rows
-
-
-class _TrackFields:
-    """Offsets of one track's entries in the flat observation."""
-
-    __slots__ = ("deviation", "time_left", "time_left_residual", "flags", "course")
-
-    def __init__(self, layout: ObservationLayout, body: int, name: str) -> None:
-        def at(field: str) -> int:
-            return layout.body_slice(body, f"{name}_{field}").start
-
-        self.deviation = (at("deviation"), at("deviation_residual"))
-        self.time_left, self.time_left_residual = at("time_left"), at("time_left_residual")
-        self.flags = at("flags")
-        self.course = at("course_start")
-        slices = [layout.body_slice(body, f"{name}_{x}") for x in _COURSE_FIELDS]
-        if [(sl.start - self.course, sl.stop - self.course) for sl in slices] != _COURSE_LAYOUT:
-            raise ValueError("the course constants are not where _course_constants reads them")
-
-
-class _BodyFields:
-    """Offsets of one body's entries (value, residual), computed once per expert."""
-
-    __slots__ = (
-        "body", "orientation", "angular_velocity", "linear_velocity", "point_offset",
-        "point_velocity", "position_track", "orientation_track",
-    )  # fmt: skip
-
-    def __init__(self, layout: ObservationLayout, index: int, body: BodyModel) -> None:
-        def at(field: str) -> tuple[int, int]:
-            return (
-                layout.body_slice(index, field).start,
-                layout.body_slice(index, f"{field}_residual").start,
-            )
-
-        self.body = body
-        self.orientation = at("orientation")
-        self.angular_velocity = at("angular_velocity")
-        self.linear_velocity = at("linear_velocity")
-        self.point_offset = at("point_offset")
-        self.point_velocity = at("point_velocity")
-        self.position_track = _TrackFields(layout, index, "position")
-        self.orientation_track = _TrackFields(layout, index, "orientation")
-
-    @staticmethod
-    def vec(o: list[float], at: tuple[int, int]) -> tuple[float, float, float]:
-        """Double-precision 3-vector: float32 entries plus their residuals."""
-        a, r = at
-        return (o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2])

@@ -15,7 +15,7 @@ import pickle
 import re
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
@@ -33,6 +33,7 @@ __all__ = [
     "BUILTIN_POLICIES",
     "EpisodeExpert",
     "NormalizedPolicy",
+    "Policy",
     "RandomPolicy",
     "algorithm_from_data",
     "load_sb3_model",
@@ -44,6 +45,24 @@ __all__ = [
 
 BUILTIN_POLICIES: tuple[str, ...] = ("expert", "dynamic-constraints", "minimum-jerk", "random")
 SB3_ALGORITHMS: tuple[str, ...] = ("PPO", "SAC", "TD3", "A2C", "DDPG")
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """What the harness, the CLI and training callbacks drive: SB3's ``predict`` signature.
+
+    The expert, the comparison controllers, :class:`RandomPolicy`, :class:`EpisodeExpert`,
+    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/test_policies.py``).
+    SB3 models default to ``deterministic=False``; the harness always passes True.
+    """
+
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]: ...
 
 
 class RandomPolicy:
@@ -234,7 +253,7 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
         )
 
 
-def make_policy(spec: str, env: Any, seed: int | None = None) -> Any:
+def make_policy(spec: str, env: Any, seed: int | None = None) -> Policy:
     """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``."""
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")

@@ -12,6 +12,7 @@ from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_sce
 
 __all__ = [
     "ENV_IDS",
+    "check_env_id",
     "Body",
     "Goal",
     "ObservationLayout",
@@ -27,6 +28,8 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
     "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
+    "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
+    "SGCThreeRodsRandom-v0": (_ENTRY, {"random_scenario": "three_rods"}),
     "SGCPointGoal-v0": ("sgc_env.envs.goal_env:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
@@ -34,3 +37,11 @@ ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
         gym.register(id=_id, entry_point=_entry, kwargs=_kwargs)
+
+
+def check_env_id(env_id: object, field: str = "env_id") -> str:
+    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
+    SGC ids (the one check of the package, the harness, training and the CLI)."""
+    if not isinstance(env_id, str) or env_id not in gym.registry:
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")
+    return env_id

@@ -15,8 +15,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from sgc_env.simulator import pybullet
-
 if TYPE_CHECKING:
     from sgc_env.scenario import Scenario
     from sgc_env.simulator import Simulator
@@ -65,24 +63,13 @@ class CameraConfig:
 
     def image(self, sim: Simulator) -> np.ndarray:
         """An (height, width, 3) uint8 frame."""
-        view = pybullet.computeViewMatrixFromYawPitchRoll(
-            list(self.target),
-            self.distance,
-            self.yaw,
-            self.pitch,
-            0.0,
-            2,
-            physicsClientId=sim.client,
-        )
-        proj = pybullet.computeProjectionMatrixFOV(
-            self.fov, self.width / self.height, 0.01, 100.0, physicsClientId=sim.client
-        )
-        return sim.camera_image(int(self.width), int(self.height), view, proj)
+        return sim.orbit_image(
+            int(self.width), int(self.height), self.target, self.distance, self.yaw, self.pitch,
+            self.fov,
+        )  # fmt: skip
 
     def point_gui(self, sim: Simulator) -> None:
-        pybullet.resetDebugVisualizerCamera(
-            self.distance, self.yaw, self.pitch, list(self.target), physicsClientId=sim.client
-        )
+        sim.point_gui_camera(self.target, self.distance, self.yaw, self.pitch)
 
 
 class NailMarkers:

@@ -1,9 +1,11 @@
 """Thin PyBullet wrapper: one physics client per instance, bodies addressed by name.
 
-Facts this module relies on (PyBullet 3.2.7, see method-notes): createMultiBody bodies get
-damping 0.04 by default, so it is switched off; external forces last a single simulation step,
-so they are re-applied on every substep; Python API calls dominate the cost, so the hot path
-(:meth:`Simulator.step_bodies`, :meth:`Simulator.read_states`) uses cached ids and bound calls.
+Every PyBullet call of the environment package goes through here (the env, its task and the
+rendering helpers never import pybullet). Facts this module relies on (PyBullet 3.2.7, see
+method-notes): createMultiBody bodies get damping 0.04 by default, so it is switched off;
+external forces last a single simulation step, so they are re-applied on every substep; Python
+API calls dominate the cost, so the hot path (:meth:`Simulator.step_bodies`,
+:meth:`Simulator.body_states`) uses cached ids and bound calls.
 """
 
 from __future__ import annotations
@@ -12,13 +14,17 @@ import contextlib
 import os
 import sys
 import tempfile
+import weakref
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["BodyHandle", "Drive", "Simulator", "pybullet"]
+__all__ = ["BodyHandle", "BodyState", "Drive", "Simulator", "connected_clients", "pybullet"]
+
+BodyState = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]
+"""One body as read back: position, quaternion xyzw, linear and angular velocity (world)."""
 
 Drive = tuple[int, Sequence[float], Sequence[float] | None, Sequence[Sequence[float]]]
 """One body's control period: (uid, force, torque or None, CoM before each substep)."""
@@ -65,8 +71,26 @@ class BodyHandle:
     mass: float
 
 
+MAX_CLIENTS = 1024  # PyBullet's limit on physics clients per process (ids are reused)
+
+
+def _disconnect(client: int) -> None:
+    with contextlib.suppress(Exception):
+        pybullet.disconnect(physicsClientId=client)
+
+
+def connected_clients() -> list[int]:
+    """Ids of the PyBullet clients this process has connected (for leak checks)."""
+    info = pybullet.getConnectionInfo
+    return [c for c in range(MAX_CLIENTS) if info(physicsClientId=c)["isConnected"]]
+
+
 class Simulator:
-    """A PyBullet client (DIRECT, or GUI for ``render_mode='human'``) holding named bodies."""
+    """A PyBullet client (DIRECT, or GUI for ``render_mode='human'``) holding named bodies.
+
+    The client is disconnected by :meth:`close` or, failing that, when the simulator is
+    garbage-collected.
+    """
 
     def __init__(self, *, gui: bool = False, sim_frequency: int = 240) -> None:
         pb = pybullet
@@ -79,11 +103,16 @@ class Simulator:
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         if self.client < 0:
             raise RuntimeError("could not connect to PyBullet (is another GUI client open?)")
+        # Frees the client when the simulator is garbage-collected unclosed (each one holds
+        # ~30 MB); close() runs the same finaliser at once.
+        self._finalizer = weakref.finalize(self, _disconnect, self.client)
         pb.setTimeStep(1.0 / self.sim_frequency, physicsClientId=self.client)
         if gui:
             pb.configureDebugVisualizer(pb.COV_ENABLE_GUI, 0, physicsClientId=self.client)
         self.bodies: dict[str, BodyHandle] = {}
         self.markers: list[int] = []
+        self._get_pose = pb.getBasePositionAndOrientation
+        self._get_velocity = pb.getBaseVelocity
 
     # ---------------------------------------------------------------- scene building
 
@@ -178,15 +207,18 @@ class Simulator:
         pybullet.resetBasePositionAndOrientation(uid, position, orientation, physicsClientId=c)
         pybullet.resetBaseVelocity(uid, linear_velocity, angular_velocity, physicsClientId=c)
 
-    def read_states(self, uids: Sequence[int]) -> list[tuple[tuple[float, ...], ...]]:
+    def body_states(self, uids: Sequence[int]) -> list[BodyState]:
         """(position, orientation, linear velocity, angular velocity) per body, one read each."""
-        pb, c = pybullet, self.client
-        out = []
-        for uid in uids:
-            pos, orn = pb.getBasePositionAndOrientation(uid, physicsClientId=c)
-            lin, ang = pb.getBaseVelocity(uid, physicsClientId=c)
-            out.append((pos, orn, lin, ang))
-        return out
+        get_pose, get_velocity = self._get_pose, self._get_velocity
+        c = self.client
+        return [
+            get_pose(uid, physicsClientId=c) + get_velocity(uid, physicsClientId=c) for uid in uids
+        ]
+
+    @staticmethod
+    def rotation_matrix(quaternion: Sequence[float]) -> np.ndarray:
+        """The 3x3 rotation matrix of a quaternion (xyzw)."""
+        return np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
 
     def step_bodies(
         self,
@@ -242,19 +274,40 @@ class Simulator:
 
     # ---------------------------------------------------------------- rendering and teardown
 
-    def camera_image(
-        self, width: int, height: int, view: Sequence[float], projection: Sequence[float]
+    def orbit_image(
+        self,
+        width: int,
+        height: int,
+        target: Sequence[float],
+        distance: float,
+        yaw: float,
+        pitch: float,
+        fov: float,
     ) -> np.ndarray:
-        """RGB image (H, W, 3) uint8 from the TinyRenderer (works headless)."""
-        pb = pybullet
+        """RGB image (H, W, 3) uint8 of an orbit camera looking at ``target`` (yaw and pitch in
+        degrees); the TinyRenderer (works headless) unless this is a GUI client."""
+        pb, c = pybullet, self.client
+        view = pb.computeViewMatrixFromYawPitchRoll(
+            list(target), distance, yaw, pitch, 0.0, 2, physicsClientId=c
+        )
+        projection = pb.computeProjectionMatrixFOV(
+            fov, width / height, 0.01, 100.0, physicsClientId=c
+        )
         renderer = pb.ER_BULLET_HARDWARE_OPENGL if self.gui else pb.ER_TINY_RENDERER
         _, _, rgba, _, _ = pb.getCameraImage(
-            width, height, view, projection, renderer=renderer, physicsClientId=self.client
+            width, height, view, projection, renderer=renderer, physicsClientId=c
         )
         return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
 
+    def point_gui_camera(
+        self, target: Sequence[float], distance: float, yaw: float, pitch: float
+    ) -> None:
+        """Aim the GUI window's camera (degrees)."""
+        pybullet.resetDebugVisualizerCamera(
+            distance, yaw, pitch, list(target), physicsClientId=self.client
+        )
+
     def close(self) -> None:
-        if self.client >= 0:
-            with contextlib.suppress(Exception):
-                pybullet.disconnect(physicsClientId=self.client)
-            self.client = -1
+        """Disconnect (idempotent); later calls on this simulator fail in PyBullet."""
+        self._finalizer()
+        self.client = -1

@@ -115,9 +115,12 @@ def test_actions_from_tuples_equal_actions_from_arrays():
     env.close()
     rng = np.random.default_rng(0)
     forces, torques = rng.normal(size=(3, 3)) * 50.0, rng.normal(size=(3, 3))
-    from_arrays = model.action_from_wrenches(forces, torques)
+    quats = rng.normal(size=(3, 4))
+    quats /= np.linalg.norm(quats, axis=1, keepdims=True)
+    from_arrays = model.action_from_wrenches(forces, torques, quats)
     from_tuples = model.action_from_wrenches(
-        [tuple(f) for f in forces.tolist()], [tuple(t) for t in torques.tolist()]
+        [tuple(f) for f in forces.tolist()], [tuple(t) for t in torques.tolist()],
+        [tuple(q) for q in quats.tolist()],
     )
     assert from_arrays.dtype == np.float64 and np.array_equal(from_arrays, from_tuples)
     assert np.max(np.abs(from_arrays)) <= 1.0

@@ -17,8 +17,10 @@ from typing import Any
 import yaml
 
 __all__ = [
+    "ALGORITHMS",
     "DEFAULT_HYPERPARAMS_DIR",
     "Hyperparams",
+    "algorithm_class",
     "linear_schedule",
     "load_hyperparams",
     "parse_kwargs_string",
@@ -137,15 +139,22 @@ def _learning_rate(value: Any) -> Any:
     return float(value)
 
 
-def _algo_class(algo: str):
-    from baselines.agents.train import algorithm_class
+ALGORITHMS: tuple[str, ...] = ("ppo", "sac", "td3", "her")
 
-    return algorithm_class(algo)
+
+def algorithm_class(algo: str):
+    """SB3 class for ``algo`` (HER is SAC with a ``HerReplayBuffer``)."""
+    from stable_baselines3 import PPO, SAC, TD3
+
+    classes = {"ppo": PPO, "sac": SAC, "td3": TD3, "her": SAC}
+    if algo not in classes:
+        raise ValueError(f"algo: unknown algorithm {algo!r}; choose from {ALGORITHMS}")
+    return classes[algo]
 
 
 def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
     """Read ``<directory>/<algo>.yml`` and resolve the entry for ``env_id``."""
-    algo_cls = _algo_class(algo)
+    algo_cls = algorithm_class(algo)
     path = Path(directory or DEFAULT_HYPERPARAMS_DIR) / f"{algo}.yml"
     if not path.is_file():
         raise ValueError(f"algo: no hyperparameter file {path}")

@@ -11,6 +11,8 @@ import importlib
 import sys
 from collections.abc import Sequence
 
+from baselines.cli.checks import UsageError
+
 __all__ = ["COMMANDS", "build_parser", "main"]
 
 COMMANDS: dict[str, str] = {
@@ -38,9 +40,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     words = list(sys.argv[1:] if argv is None else argv)
-    args = build_parser().parse_args(words)
+    try:
+        args = build_parser().parse_args(words)
+    except SystemExit as exc:  # argparse: --help (0), or a bad argument reported in one line (2)
+        return int(exc.code or 0)
     args.argv = words  # for commands that record how they were called
-    return int(args._module.run(args) or 0)
+    try:
+        return int(args._module.run(args) or 0)
+    except UsageError as exc:  # a bad argument found before any work; real bugs still raise
+        print(f"sgc {args.command}: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -11,8 +11,12 @@ Dict observation:
 A goal is met when the point is within ``tolerance`` m of the nail *on the goal's tick*
 (|time difference| below half a control period): reward 0, else -1 (sparse, vectorised in
 :meth:`compute_reward`). The step reward is ``compute_reward(achieved after the step, desired
-before it)``, the same pairing HER uses, so relabelled rewards agree with the env's own.
-Physics, actions, termination and truncation are those of :class:`SGCEnv`.
+before it, info)``, the same call HER makes, so relabelled rewards agree with the env's own.
+A failure (``terminated``) also charges -1 for every step the episode had left
+(``info["failure_charge"]``, read by :meth:`compute_reward` so relabelled terminal steps keep
+it): otherwise leaving the workspace early would end the stream of -1 and pay. Physics,
+actions, termination and truncation are those of :class:`SGCEnv`; the ``reward=`` modes of
+:class:`SGCEnv` do not apply (a ``ValueError`` says so).
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.defaults import POSITION_TOLERANCE
 from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
 
 __all__ = ["SGCGoalEnv"]
@@ -30,10 +35,16 @@ __all__ = ["SGCGoalEnv"]
 class SGCGoalEnv(SGCEnv):
     """:class:`SGCEnv` with a Dict observation (observation, achieved_goal, desired_goal)."""
 
-    def __init__(self, *args: Any, tolerance: float = 0.02, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, tolerance: float = POSITION_TOLERANCE, **kwargs: Any) -> None:
+        if kwargs.get("reward") is not None:
+            raise ValueError(
+                "reward: the goal-conditioned env's reward is its sparse goal reward "
+                "(compute_reward); reward modes apply to SGCEnv ids only"
+            )
         super().__init__(*args, **kwargs)
+        del self._init_kwargs["reward"]  # the base mode is unused here; pickles re-make it
         self._init_kwargs["tolerance"] = tolerance
-        if self.tracks[0].position is None:
+        if not self.task.has_position[0]:
             raise ValueError("the goal-conditioned env needs a position track on body 0")
         self.tolerance = float(tolerance)
         box = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (4,), np.float32)
@@ -47,13 +58,10 @@ class SGCGoalEnv(SGCEnv):
         )
 
     def _dict_obs(self) -> dict[str, np.ndarray]:
-        tr = self.tracks[0].position
-        k = self._pos_idx[0]
-        t = self._tick * self.dt
         return {
             "observation": self._obs.copy(),
-            "achieved_goal": np.array([*self._point_pos[0], t], dtype=np.float32),
-            "desired_goal": np.array([*tr.targets[k], tr.times[k]], dtype=np.float32),  # type: ignore[union-attr]
+            "achieved_goal": self.task.achieved_goal(0),
+            "desired_goal": self.task.desired_goal(0),
         }
 
     def reset(
@@ -68,6 +76,8 @@ class SGCGoalEnv(SGCEnv):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         desired = self._last["desired_goal"]
         _, _, terminated, truncated, info = super().step(action)
+        if terminated:
+            info["failure_charge"] = float(self.max_steps - self._tick)
         obs = self._dict_obs()
         reward = float(self.compute_reward(obs["achieved_goal"], desired, info))
         self._last = obs
@@ -85,9 +95,17 @@ class SGCGoalEnv(SGCEnv):
     def compute_reward(
         self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any
     ) -> np.ndarray:
-        """0 where the point is on the nail on the goal's tick, else -1; any leading shape."""
+        """0 where the point is on the nail on the goal's tick, else -1, minus the failure charge
+        of a terminal step; any leading shape (``info``: one dict, or one per leading entry)."""
         a = np.asarray(achieved_goal, dtype=np.float64)
         d = np.asarray(desired_goal, dtype=np.float64)
         dist = np.linalg.norm(a[..., :3] - d[..., :3], axis=-1)
         on_time = np.abs(a[..., 3] - d[..., 3]) < 0.5 * self.dt
-        return np.where((dist <= self.tolerance) & on_time, 0.0, -1.0).astype(np.float32)
+        reward = np.where((dist <= self.tolerance) & on_time, 0.0, -1.0)
+        if isinstance(info, dict):
+            reward = reward - info.get("failure_charge", 0.0)
+        elif info is not None:
+            charges = [i.get("failure_charge", 0.0) if isinstance(i, dict) else 0.0
+                       for i in np.asarray(info, dtype=object).reshape(-1)]  # fmt: skip
+            reward = reward - np.reshape(charges, reward.shape)
+        return reward.astype(np.float32)

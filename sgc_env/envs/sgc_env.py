@@ -8,12 +8,19 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz in the world frame,
-scaled by the body's ``force_limit`` (N) and ``torque_limit`` (N m). When every body is a
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
+``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
+``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
+that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
+axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
+start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
+its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
+1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
+orientation goal; scaled body axes make every axis equally sensitive. When every body is a
 sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
 the centre of mass; gravity is *not* compensated. The action is held for one control period
 (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep.
+every substep (the world torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -40,17 +47,38 @@ reaches t_i already describes goal i+1.
 
 ## Rewards
 
-``r = -mean_b(|D_b| / L_b + |phi_b| / A_b) - 0.01 * mean(a^2) + sum over goals met this tick of
-exp(-|D| / 0.01 m) (+ exp(-|phi| / 0.02 rad))``, with ``L_b = max(|D_i(0)|, 0.1 m)`` and
-``A_b = max(|phi_i(0)|, 0.5 rad)`` of the current course. Dense, bounded by the bonus.
+``reward=`` (constructor, ``gym.make(id, reward=...)``) picks one of three modes
+(:mod:`sgc_env.envs.rewards` has the code; ``D`` the tracked point's deviation, ``D_i(0)`` and
+``T_i`` the current course's start deviation and duration, ``L = max(|D_i(0)|, 0.1 m)``; the
+same for orientation with ``phi`` and ``A = max(|phi_i(0)|, 0.5 rad)``; ``bonus`` = per goal met
+this tick ``exp(-|D| / 0.01 m)`` (+ ``exp(-|phi| / 0.02 rad)``); means over bodies):
+
+- ``"schedule"`` (default): ``r = -mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2)
+  + bonus`` with ``D_sched = D_i(0) time_left / T_i`` (after the last goal ``-v_end
+  time_left``, carrying on at the end velocity). ``D_sched`` is the paper's behaviour equation
+  ``D'' - 2a D' + (a^2 + b^2) D = 0``, ``D(T) = 0``, ``D'(T) = -k D0 / T`` in its neutral member
+  (``k = 1``, ``a = b = 0``): the course travelled on schedule. It depends only on the course
+  and the clock, so the cost vanishes only where the body should be *now*: reaching the nail
+  early and hovering costs ``time_left / T_i`` per step, as does arriving late, and the bonus
+  pays for exactness on the tick; the SGC expert departs from it only by its smooth course
+  starts and earns close to the maximum.
+- ``"distance"`` (the reward before the modes): ``r = -mean_b(|D| / L + |phi| / A) - 0.01
+  mean(a^2) + bonus``. It pays for reaching the nail early and hovering, and ranks the early,
+  inexact dynamic-constraints controller above the expert; kept for comparison.
+- ``"sparse"``: ``r = -0.01 mean(a^2) + bonus``.
+
+A failure (``terminated``) under ``schedule`` and ``sparse`` also charges every step the episode
+had left at the mode's worst per-step reward (``mean_b(tracks) + 0.01``, resp. ``0.01``; the
+per-track cost is capped at 1 for this), so leaving the workspace never ends a negative stream
+early; ``distance`` charges nothing, as before. An unknown mode is a ``ValueError`` naming the
+choices.
 
 ## Episode end
 
 ``truncated`` at the last goal time + ``scenario.margin`` (reaching a goal never ends an
 episode). ``terminated`` on failure: non-finite state, a body CoM outside the workspace box, or
-a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s; a
-thin rod's axial spin reaches that within a step under random torques, so it is not terminal:
-``info["spin_clamped"]`` flags it (the physics is then no longer exact).
+a speed over 90 m/s (PyBullet clamps at 100 m/s). PyBullet also clamps |omega| at 100 rad/s;
+that is not terminal: ``info["spin_clamped"]`` flags it (the physics is then no longer exact).
 
 ## Info
 
@@ -58,17 +86,18 @@ Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_g
 (index into the body's goal list, -1 without a track), ``position_deviation``,
 ``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
 ``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
-``{body, goal, time, position_error, orientation_error}`` (norms of D and phi at that tick;
-None for a missing part).
+``{body, goal, time, position_error, orientation_error}`` (|D| and the angle between body and
+goal orientation, in [0, pi], at that tick; None for a missing part).
 
 ## Arguments
 
-``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
-:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
-reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
-an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
+``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
+(240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
-distance, yaw, pitch, target, width, height). ``reset(options={"scenario": ...})`` swaps the
+distance, yaw, pitch, target, width, height), ``reward`` (``"schedule"``, ``"distance"`` or
+``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
 plain reset).
 """
@@ -77,43 +106,37 @@ from __future__ import annotations
 
 import math
 import struct
+import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import gymnasium as gym
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.paper.quaternion import rotate
+from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
-from sgc_env.simulator import Drive, Simulator, pybullet
+from sgc_env.simulator import Drive, Simulator
 
-from .tracks import (
-    BodyTracks,
-    Track,
-    compile_tracks,
-    quat_conj_mul,
-    rotate,
-    rotvec_from_quat,
-    unwrap_rotvec,
-)
+from .props import PropPaths
+from .rewards import make_reward
+from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
 
-__all__ = ["SGCEnv", "SavedState"]
+__all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
 SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
 
-# Offsets inside a body block (see sgc_env.observation.BODY_FIELDS).
-_BLOCK = ObservationLayout(1)
-_DEV = _BLOCK.body_slice(0, "position_deviation").start
 # Per-body columns of the (bodies, block) record that info hands out as views; built once
 # because constructing the index tuples costs as much as the slicing itself.
-_COL_DEV = np.s_[:, _DEV : _DEV + 3]
+_BLOCK = ObservationLayout(1)
+_COL_DEV = np.s_[:, _BLOCK.body_slice(0, "position_deviation")]
 _COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
 _COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
 _COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
@@ -122,8 +145,42 @@ _COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
 _COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
 _COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
 _COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
-_ZERO3 = (0.0, 0.0, 0.0)
-_ZERO6 = (0.0,) * 6
+
+
+class _StepInfoEveryStep(TypedDict):
+    time: float
+    goal_index: np.ndarray
+    orientation_goal_index: np.ndarray
+    position_deviation: np.ndarray
+    orientation_deviation: np.ndarray
+    time_to_goal: np.ndarray
+    orientation_time_to_goal: np.ndarray
+    body_position: np.ndarray
+    body_orientation: np.ndarray
+    body_velocity: np.ndarray
+    body_angular_velocity: np.ndarray
+    point_position: np.ndarray
+    point_velocity: np.ndarray
+    force: np.ndarray
+    torque: np.ndarray
+    spin_clamped: bool
+
+
+class StepInfo(_StepInfoEveryStep, total=False):
+    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
+    one row per body; ``goal_reached`` only on a tick where goals fall."""
+
+    goal_reached: list[GoalEvent]
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    """A scenario checked against an env, with what it compiles to (see SGCEnv._prepare)."""
+
+    scenario: Scenario
+    task: GoalTask
+    max_steps: int
+    props: PropPaths
 
 
 @dataclass(frozen=True)
@@ -133,11 +190,30 @@ class SavedState:
     bullet_state: int
     counters: dict[str, Any]
 
+    def free(self) -> None:
+        """Free the PyBullet copy now instead of when this object is garbage-collected."""
+        release = getattr(self, "_release", None)
+        if release is not None:
+            release()
 
-def _with(array: np.ndarray, i: int, value: int) -> np.ndarray:
-    out = array.copy()
-    out[i] = value
-    return out
+    @property
+    def alive(self) -> bool:
+        """False once freed (explicitly or because its env closed)."""
+        release = getattr(self, "_release", None)
+        if release is None:
+            return True
+        details = release.peek()
+        return details is not None and _sim_open(details[2][0])
+
+
+def _sim_open(sim_ref: weakref.ref[Simulator]) -> bool:
+    sim = sim_ref()
+    return sim is not None and sim.client >= 0
+
+
+def _remove_state(sim_ref: weakref.ref[Simulator], state_id: int) -> None:
+    if _sim_open(sim_ref):
+        sim_ref().remove_state(state_id)  # type: ignore[union-attr]
 
 
 def _as_scenario(spec: Scenario | str | Path) -> Scenario:
@@ -151,17 +227,6 @@ def _geometry(s: Scenario) -> tuple:
     )
 
 
-def _course_fields(track: Track, k: int) -> tuple[float, ...]:
-    """The 13 static observation entries of a track's course ``k``: course start and duration,
-    next start and duration, end velocity (last goal only) and the two flags."""
-    last = k == track.size - 1
-    end = tuple(track.end_velocity) if last else (0.0, 0.0, 0.0)
-    return (
-        *track.course_start[k].tolist(), float(track.durations[k]),
-        *track.next_start[k].tolist(), float(track.next_duration[k]), *end, 1.0, float(last),
-    )  # fmt: skip
-
-
 class SGCEnv(gym.Env):
     """Sequential-goal constraints on free rigid bodies (see the module docstring)."""
 
@@ -171,18 +236,22 @@ class SGCEnv(gym.Env):
         self,
         scenario: Scenario | str | Path | None = None,
         *,
-        random_scenario: RandomScenarioConfig | str | None = None,
+        random_scenario: SceneFamily | str | None = None,
         control_frequency: int | None = None,
         sim_frequency: int = 240,
         time_grid: str | None = None,
         render_mode: str | None = None,
         camera: dict[str, Any] | None = None,
+        reward: str = "schedule",
     ) -> None:
         self._init_kwargs = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
+            "reward": reward,
         }  # fmt: skip
+        self.reward_mode = reward
+        self._reward: RewardFunction = make_reward(reward)
         if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
             raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
         if scenario is None and random_scenario is None:
@@ -191,13 +260,11 @@ class SGCEnv(gym.Env):
             )
         self.render_mode = render_mode
         self.camera = CameraConfig.from_dict(camera)
-        self._random_config: RandomScenarioConfig | None = None
+        self._random_config: SceneFamily | None = None
         if scenario is None:
             cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
             if control_frequency is not None:
-                cfg = RandomScenarioConfig(
-                    **{**cfg.__dict__, "control_frequency": control_frequency}
-                )
+                cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
@@ -238,15 +305,21 @@ class SGCEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
-        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
-        self._get_pose = pybullet.getBasePositionAndOrientation
-        self._get_velocity = pybullet.getBaseVelocity
         self._markers: NailMarkers | None = None
+        self._closed = False
         self.scenario: Scenario = base
         self._geometry: tuple = ()
-        self._build(base)
-        self._set_scenario(base)
-        self._reset_state()
+        # Everything that can reject the scenario runs before the PyBullet client exists; if
+        # building the scene still fails, the client is closed before the error propagates.
+        prepared = self._prepare(base)
+        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        try:
+            self._build(base)
+            self._commit(prepared)
+            self._reset_state()
+        except BaseException:
+            self.sim.close()
+            raise
 
     # ---------------------------------------------------------------- scenario handling
 
@@ -279,6 +352,12 @@ class SGCEnv(gym.Env):
             self._markers.clear()
 
     def _set_scenario(self, s: Scenario) -> None:
+        """Switch to ``s`` all at once: everything is checked and compiled before the env
+        changes, so a rejected scenario leaves the env exactly as it was."""
+        self._commit(self._prepare(s))
+
+    def _prepare(self, s: Scenario) -> _Prepared:
+        """Check ``s`` against this env and compile its tracks; changes nothing."""
         if len(s.bodies) != self._n:
             raise ValueError(
                 f"scenario has {len(s.bodies)} bodies, this env was made for {self._n}"
@@ -291,57 +370,58 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
+        last_tick = max(
+            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
+        )
+        max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
+        return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
+
+    def _commit(self, prepared: _Prepared) -> None:
+        """Make a prepared scenario current. Rebuilding bodies is the one step that talks to
+        PyBullet; if it fails, the previous scene is rebuilt before the error propagates."""
+        s = prepared.scenario
         if _geometry(s) != self._geometry:
-            self._build(s)
+            previous = self.scenario
+            try:
+                self._build(s)
+            except BaseException:
+                self._build(previous)
+                raise
         self.scenario = s
         self.sim.set_gravity(s.gravity)
         self._gravity = tuple(float(g) for g in s.gravity)
-        self.tracks: list[BodyTracks] = compile_tracks(s)
-        self._has_pos = [bt.position is not None for bt in self.tracks]
-        self._has_ori = [bt.orientation is not None for bt in self.tracks]
-        self._init_caches()
+        self.task = prepared.task
+        self.max_steps = prepared.max_steps
+        self._props = prepared.props
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
-        self._tlimit = [float(b.torque_limit) for b in s.bodies]
+        self.torque_scale = np.array(
+            [float(b.torque_limit) * inertia / inertia.max()
+             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        )  # fmt: skip
+        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        self.max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
-        self._prop_table = self._prop_positions(s)
         if self._markers is not None:
             self._markers.place(s)
-
-    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, float, float]]]:
-        """Kinematic prop positions at every substep time of the episode (computed once)."""
-        if not s.props:
-            return []
-        n_sub = (self.max_steps + 1) * self.substeps + 1
-        t = np.arange(n_sub) / self.sim_frequency
-        table = []
-        for p in s.props:
-            if p.waypoints:
-                times = [w[0] for w in p.waypoints]
-                pts = np.asarray([w[1] for w in p.waypoints])
-                xyz = np.stack([np.interp(t, times, pts[:, j]) for j in range(3)], axis=1)
-            else:
-                xyz = np.asarray(p.position) + np.outer(t, p.velocity)
-            table.append(xyz)
-        arr = np.stack(table, axis=1)
-        return [[tuple(map(float, row)) for row in step] for step in arr]
 
     # ---------------------------------------------------------------- reset / step
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
+    ) -> tuple[np.ndarray, StepInfo]:
+        self._check_open()
         options = options or {}
+        prepared = None
         if options.get("scenario") is not None:
-            self._set_scenario(self._resolve(_as_scenario(options["scenario"])))
+            # Checked and compiled before the seed or anything else changes (transactional).
+            prepared = self._prepare(self._resolve(_as_scenario(options["scenario"])))
+        super().reset(seed=seed)
+        if prepared is not None:
+            self._commit(prepared)
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
@@ -356,132 +436,45 @@ class SGCEnv(gym.Env):
                 uid, b.position, b.orientation, b.linear_velocity, b.angular_velocity
             )
         if self._prop_uids:
-            for uid, pos in zip(self._prop_uids, self._prop_table[0], strict=True):
+            for uid, pos in zip(self._prop_uids, self._props.at(0), strict=True):
                 self.sim.move(uid, pos)
         self._tick = 0
         self._zeros3n = [0.0] * (3 * self._n)
         self._applied = [0.0] * (6 * self._n)
-        self._pos_idx = [0] * self._n
-        self._ori_idx = [0] * self._n
-        self._phi = [
-            tr.orientation.course_start[0].tolist() if tr.orientation else [0.0] * 3
-            for tr in self.tracks
-        ]
-        for i in range(self._n):
-            self._write_static(i)
+        self.task.reset()
         self._observe()
 
-    def _write_static(self, i: int) -> None:
-        """Cache what changes only when a body's current goal changes (as Python tuples)."""
-        zeros13 = (0.0,) * 13
-        tr = self.tracks[i].position
-        if tr is not None:
-            k = self._pos_idx[i]
-            self._s_offset[i] = tuple(tr.points[k].tolist())
-            self._s_offset_residual[i] = float32_residuals(self._s_offset[i])
-            self._s_nail[i] = tuple(tr.targets[k].tolist())
-            self._s_ptime[i] = float(tr.times[k])
-            self._s_pos[i] = _course_fields(tr, k)
-            self._s_pscale[i] = 1.0 / max(float(np.linalg.norm(tr.course_start[k])), 0.1)
-            self._goal_index = _with(self._goal_index, i, int(tr.goal_ids[k]))
-        else:
-            self._s_offset[i] = (0.0, 0.0, 0.0)
-            self._s_offset_residual[i] = [0.0, 0.0, 0.0]
-            self._s_pos[i] = zeros13
-        to = self.tracks[i].orientation
-        if to is not None:
-            k = self._ori_idx[i]
-            self._s_quat[i] = tuple(to.targets[k].tolist())
-            self._s_otime[i] = float(to.times[k])
-            self._s_ori[i] = _course_fields(to, k)
-            self._s_oscale[i] = 1.0 / max(float(np.linalg.norm(to.course_start[k])), 0.5)
-            self._ori_goal_index = _with(self._ori_goal_index, i, int(to.goal_ids[k]))
-        else:
-            self._s_ori[i] = zeros13
-        self._next_event = self._first_pending_tick()
-
-    def _first_pending_tick(self) -> int:
-        """The earliest goal tick still ahead of the current tick (-1 when none is left)."""
-        ticks = []
-        for j, bt in enumerate(self.tracks):
-            if bt.position is not None:
-                ticks.append(int(bt.position.ticks[self._pos_idx[j]]))
-            if bt.orientation is not None:
-                ticks.append(int(bt.orientation.ticks[self._ori_idx[j]]))
-        ahead = [k for k in ticks if k > self._tick]
-        return min(ahead) if ahead else -1
-
-    def _init_caches(self) -> None:
-        n = self._n
-        self._s_offset: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
-        self._s_offset_residual: list[list[float]] = [[0.0, 0.0, 0.0]] * n
-        self._s_nail: list[tuple[float, ...]] = [(0.0, 0.0, 0.0)] * n
-        self._s_quat: list[tuple[float, ...]] = [(0.0, 0.0, 0.0, 1.0)] * n
-        self._s_ptime = [0.0] * n
-        self._s_otime = [0.0] * n
-        self._s_pos: list[tuple[float, ...]] = [()] * n
-        self._s_ori: list[tuple[float, ...]] = [()] * n
-        self._s_pscale = [0.0] * n
-        self._s_oscale = [0.0] * n
-        self._goal_index = np.full(n, -1)
-        self._ori_goal_index = np.full(n, -1)
-
     def _observe(self, read: bool = True) -> None:
-        """Read every body once and build the observation, deviations and failure flags.
+        """Read every body once, let the task measure it, and build the observation.
 
         Pure-Python arithmetic on tuples, one struct pack into a fresh buffer and one cast:
         for a few bodies that is several times cheaper than numpy calls on 3-vectors.
         ``read=False`` rebuilds from the last read (after a goal switch) without calling
-        PyBullet again.
+        PyBullet again. Also sets the failure and spin-clamp flags.
         """
         if read:
-            get_p, get_v, c = self._get_pose, self._get_velocity, self.sim.client
-            self._states = [
-                get_p(uid, physicsClientId=c) + get_v(uid, physicsClientId=c) for uid in self._uids
-            ]
+            self._states = self.sim.body_states(self._uids)
         t = self._tick * self.dt
-        s_offset, s_pos, s_ori = self._s_offset, self._s_pos, self._s_ori
-        has_pos, has_ori, phis = self._has_pos, self._has_ori, self._phi
+        task = self.task
+        task.measure(self._states, t)
+        offsets, residuals = task.offsets, task.offset_residuals
+        devs, phis = task.deviations, task.phi
+        ptls, otls = task.position_time_left, task.orientation_time_left
+        pcourse, ocourse = task.position_course, task.orientation_course
         flat: list[float] = []
-        points = []
-        cost = 0.0
         ok = True
         spin = 0.0
         lo, hi = self._ws_low, self._ws_high
         for i, (pos, orn, lin, ang) in enumerate(self._states):
-            offset = s_offset[i]
-            if offset == _ZERO3:
-                r, p = offset, pos
-            else:
-                r = rotate(orn, offset)
-                p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
-            points.append(p)
-            wx, wy, wz = ang
-            if has_pos[i]:
-                nail = self._s_nail[i]
-                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
-                dev = (
-                    dx, dy, dz, lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
-                    lin[2] + wx * r[1] - wy * r[0],
-                )  # fmt: skip
-                ptl = self._s_ptime[i] - t
-                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * self._s_pscale[i]
-            else:
-                dev, ptl = _ZERO6, 0.0
-            if has_ori[i]:
-                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, self._s_quat[i])), phis[i])
-                phis[i] = phi
-                otl = self._s_otime[i] - t
-                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * self._s_oscale[i]
-            else:
-                phi, otl = _ZERO3, 0.0
+            dev, phi, ptl, otl = devs[i], phis[i], ptls[i], otls[i]
             # The residual slots follow in RESIDUAL_FIELDS order (pinned by a test); the point
             # offset's is cached with the goal.
             flat += [
-                *pos, *orn, *lin, *ang, *offset, *dev, ptl, *s_pos[i], *phi, otl, *s_ori[i],
-                *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
-                *self._s_offset_residual[i],
+                *pos, *orn, *lin, *ang, *offsets[i], *dev, ptl, *pcourse[i], *phi, otl,
+                *ocourse[i], *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
+                *residuals[i],
             ]  # fmt: skip
+            wx, wy, wz = ang
             spin = max(spin, wx * wx + wy * wy + wz * wz)
             if ok:
                 vx, vy, vz = lin
@@ -493,7 +486,7 @@ class SGCEnv(gym.Env):
                     and spin == spin
                 )  # fmt: skip
         flat.append(t)
-        for p in points:
+        for p in task.points:
             flat += p
         flat += self._applied
         # A fresh buffer every step (callers keep old observations and infos); the info
@@ -505,20 +498,26 @@ class SGCEnv(gym.Env):
         self._obs = arr[:size].astype(np.float32)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
-        self._point_pos = points
-        self._cost = cost
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
+        if self._closed:
+            self._check_open()
+        a = action if type(action) is np.ndarray else np.asarray(action)
+        if a.dtype.kind not in "fiu":
+            raise TypeError(f"action must hold real numbers, got dtype {a.dtype}: {action!r}")
         if a.shape != self._action_shape:
             raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
         values = a.tolist()
-        if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
-            raise ValueError(f"action contains non-finite values: {values}")
-        if max(values) > 1.0 or min(values) < -1.0:
+        hi, lo = max(values), min(values)
+        if hi > 1.0 or lo < -1.0:
+            if hi == math.inf or lo == -math.inf:
+                raise ValueError(f"action contains non-finite values: {values}")
             values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
+        # Clipped first, so the sum cannot overflow: it is NaN only if an entry is.
+        if math.isnan(sum(values)):
+            raise ValueError(f"action contains non-finite values: {values}")
         use_torque = self.use_torque
         per = 6 if use_torque else 3
         gx, gy, gz = self._gravity
@@ -526,7 +525,7 @@ class SGCEnv(gym.Env):
         drives: list[Drive] = []
         applied_f: list[float] = []
         applied_t: list[float] = []
-        for i, (pos, _, lin, _) in enumerate(self._states):
+        for i, (pos, orn, lin, _) in enumerate(self._states):
             fl = self._flimit[i]
             o = i * per
             fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
@@ -534,8 +533,8 @@ class SGCEnv(gym.Env):
             applied_f += f
             tq = None
             if use_torque:
-                tl = self._tlimit[i]
-                tq = (values[o + 3] * tl, values[o + 4] * tl, values[o + 5] * tl)
+                sx, sy, sz = self._tscale[i]
+                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
@@ -550,86 +549,36 @@ class SGCEnv(gym.Env):
         moves: list[list[tuple[int, tuple[float, float, float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
-            last = len(self._prop_table) - 1  # props hold still if stepped past truncation
+            at = self._props.at
             moves = [
-                list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
+                list(zip(self._prop_uids, at(base + k + 1), strict=True))
                 for k in range(self.substeps)
             ]
         self.sim.step_bodies(drives, moves)
         self._applied = applied_f + (applied_t or self._zeros3n)
         self._tick += 1
         self._observe()
-        events = self._advance_goals() if self._tick >= self._next_event >= 0 else []
-        reward = self._reward(values, events)
+        task = self.task
+        events: list[GoalEvent] = []
+        if self._tick >= task.next_event >= 0:
+            events, changed = task.advance(self._tick)
+            if changed:
+                self._observe(read=False)
         terminated = self._failed
+        steps_left = self.max_steps - self._tick
+        reward = task.reward_function(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":
             self.render()
         return self._obs, reward, terminated, truncated, info
 
-    def _advance_goals(self) -> list[dict[str, Any]]:
-        """Record goals whose tick is now, then move the observation to the next goals."""
-        events: list[dict[str, Any]] = []
-        tick = self._tick
-        any_changed = False
-        for i, bt in enumerate(self.tracks):
-            changed = False
-            hits: dict[int, dict[str, Any]] = {}
-            tr, to = bt.position, bt.orientation
-            if tr is not None and tr.ticks[self._pos_idx[i]] == tick:
-                k = self._pos_idx[i]
-                d = self._block[i, _DEV : _DEV + 3]
-                g = int(tr.goal_ids[k])
-                hits[g] = {
-                    "body": i,
-                    "goal": g,
-                    "time": tick * self.dt,
-                    "position_error": float(math.sqrt(d @ d)),
-                    "orientation_error": None,
-                }
-                if k < tr.size - 1:
-                    self._pos_idx[i] = k + 1
-                    changed = True
-            if to is not None and to.ticks[self._ori_idx[i]] == tick:
-                k = self._ori_idx[i]
-                phi = self._phi[i]
-                g = int(to.goal_ids[k])
-                if not to.via[k]:
-                    ev = hits.setdefault(
-                        g, {"body": i, "goal": g, "time": tick * self.dt, "position_error": None}
-                    )
-                    ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
-                if k < to.size - 1:
-                    self._ori_idx[i] = k + 1
-                    start = to.course_start[k + 1]
-                    self._phi[i] = (phi[0] + start[0], phi[1] + start[1], phi[2] + start[2])
-                    changed = True
-            for g in sorted(hits):
-                events.append(hits[g])
-            if changed:
-                self._write_static(i)
-                any_changed = True
-        if any_changed:
-            self._observe(read=False)
-        self._next_event = self._first_pending_tick()
-        return events
-
-    def _reward(self, values: list[float], events: list[dict[str, Any]]) -> float:
-        reward = -self._cost / self._n - 0.01 * sum([x * x for x in values]) / len(values)
-        for ev in events:
-            if ev["position_error"] is not None:
-                reward += math.exp(-ev["position_error"] / 0.01)
-            if ev["orientation_error"] is not None:
-                reward += math.exp(-ev["orientation_error"] / 0.02)
-        return reward
-
-    def _info(self, events: list[dict[str, Any]]) -> dict[str, Any]:
+    def _info(self, events: list[GoalEvent]) -> StepInfo:
         block, tail = self._block, self._tail
-        info: dict[str, Any] = {
+        info: StepInfo = {
             "time": self._tick * self.dt,
-            "goal_index": self._goal_index.copy(),
-            "orientation_goal_index": self._ori_goal_index.copy(),
+            "goal_index": self.task.goal_index.copy(),
+            "orientation_goal_index": self.task.orientation_goal_index.copy(),
             "position_deviation": block[_COL_DEV],
             "orientation_deviation": block[_COL_ODEV],
             "time_to_goal": block[_COL_PTL],
@@ -649,30 +598,39 @@ class SGCEnv(gym.Env):
         return info
 
     def _counters(self) -> dict[str, Any]:
-        return {
-            "tick": self._tick,
-            "pos_idx": list(self._pos_idx),
-            "ori_idx": list(self._ori_idx),
-            "phi": [list(p) for p in self._phi],
-            "scenario": self.scenario,
-        }
+        return {"tick": self._tick, "task": self.task.counters(), "scenario": self.scenario}
 
     def _apply_counters(self, c: dict[str, Any]) -> None:
         if c["scenario"] is not self.scenario:
             self._set_scenario(c["scenario"])
         self._tick = c["tick"]
-        self._pos_idx = list(c["pos_idx"])
-        self._ori_idx = list(c["ori_idx"])
-        self._phi = [list(p) for p in c["phi"]]
-        for i in range(self._n):
-            self._write_static(i)
+        task_counters: TaskCounters = c["task"]
+        self.task.restore(task_counters, self._tick)
 
     def save_state(self) -> SavedState:
-        """Snapshot physics (PyBullet saveState, in memory) and the env's goal counters."""
-        return SavedState(self.sim.save_state(), self._counters())
+        """Snapshot physics (PyBullet saveState, in memory, ~100 KB) and the goal counters.
+
+        The PyBullet copy is freed by :meth:`SavedState.free` (or :meth:`free_state`), when the
+        snapshot is garbage-collected, or when the env closes, whichever comes first.
+        """
+        self._check_open()
+        state = SavedState(self.sim.save_state(), self._counters())
+        object.__setattr__(
+            state,
+            "_release",
+            weakref.finalize(state, _remove_state, weakref.ref(self.sim), state.bullet_state),
+        )
+        return state
+
+    def free_state(self, state: SavedState) -> None:
+        """Free a snapshot's PyBullet copy now (restoring it afterwards is an error)."""
+        state.free()
 
     def restore_state(self, state: SavedState) -> np.ndarray:
         """Return to a :meth:`save_state` snapshot; returns the observation there."""
+        self._check_open()
+        if not state.alive:
+            raise ValueError("this saved state was freed (SavedState.free); save a new one")
         self.sim.restore_state(state.bullet_state)
         self._apply_counters(state.counters)
         self._observe()
@@ -690,6 +648,7 @@ class SGCEnv(gym.Env):
         the body's velocities at once, as an impact would. Policies see the push in the
         returned observation, which replaces the one from the last step.
         """
+        self._check_open()
         i = self.scenario.body_index(body) if isinstance(body, str) else int(body)
         if not 0 <= i < self._n:
             raise ValueError(f"body: no body {body!r} in a scene of {self._n}")
@@ -697,7 +656,7 @@ class SGCEnv(gym.Env):
         if dp.shape != (3,) or dl.shape != (3,) or not np.all(np.isfinite([*dp, *dl])):
             raise ValueError(f"impulse must be two finite 3-vectors, got {linear!r}, {angular!r}")
         pos, orn, lin, ang = self._states[i]
-        rm = np.array(pybullet.getMatrixFromQuaternion(orn)).reshape(3, 3)
+        rm = self.sim.rotation_matrix(orn)
         inverse_inertia = rm @ np.diag(1.0 / self.body_inertia[i]) @ rm.T
         new_lin = np.asarray(lin) + dp / self._mass[i]
         new_ang = np.asarray(ang) + inverse_inertia @ dl
@@ -706,6 +665,7 @@ class SGCEnv(gym.Env):
         return self._obs
 
     def __getstate__(self) -> dict[str, Any]:
+        self._check_open()
         return {
             "init_kwargs": self._init_kwargs,
             "counters": self._counters(),
@@ -726,6 +686,7 @@ class SGCEnv(gym.Env):
     # ---------------------------------------------------------------- rendering
 
     def render(self) -> np.ndarray | None:
+        self._check_open()
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
             return None
@@ -738,7 +699,13 @@ class SGCEnv(gym.Env):
         return None
 
     def close(self) -> None:
-        if getattr(self, "sim", None) is not None:
-            self.sim.close()
-            self.sim = None  # type: ignore[assignment]
+        """Disconnect the PyBullet client (saved states go with it). Idempotent."""
+        sim = getattr(self, "sim", None)
+        if sim is not None:
+            sim.close()
+        self._closed = True
         super().close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError("this SGCEnv is closed (close() was called); make a new env")

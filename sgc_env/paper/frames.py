@@ -34,6 +34,13 @@ import numpy as np
 
 from sgc_env.paper.course import CourseProfile, HermiteProfile, HoldProfile
 
+Vec3 = tuple[float, float, float]
+Rows = tuple[Vec3, Vec3, Vec3]
+"""A frame ``S_i`` as three row tuples (world unit vectors)."""
+Vector = Sequence[float] | np.ndarray
+"""A 3-vector as any sequence of floats or an array."""
+Profile = CourseProfile | HermiteProfile | HoldProfile
+
 __all__ = [
     "C_HIGH",
     "C_LOW",
@@ -59,7 +66,7 @@ _SQ6 = 1.0 / math.sqrt(6.0)
 _SQ2 = 1.0 / math.sqrt(2.0)
 
 
-def _vec3(x, name: str) -> tuple[float, float, float]:
+def _vec3(x: Vector, name: str) -> Vec3:
     """Three Python floats (the hot path avoids numpy on 3-vectors); validates finiteness."""
     try:
         a0, a1, a2 = (x.tolist() if isinstance(x, np.ndarray) else x)
@@ -71,7 +78,7 @@ def _vec3(x, name: str) -> tuple[float, float, float]:
     return a0, a1, a2
 
 
-def _frame_rows(d, nxt):
+def _frame_rows(d: Vec3, nxt: Vec3 | None) -> tuple[Rows, float] | None:
     """Rows of ``S_i`` (world unit vectors) from Python-float 3-tuples; None if ``d`` is 0."""
     d0, d1, d2 = d
     norm = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
@@ -114,7 +121,7 @@ def _frame_rows(d, nxt):
     ), norm
 
 
-def _mul(rows, v) -> tuple[float, float, float]:
+def _mul(rows: Rows, v: Vec3) -> Vec3:
     """``R @ v`` for rows and a vector given as tuples."""
     v0, v1, v2 = v
     r0, r1, r2 = rows
@@ -125,7 +132,7 @@ def _mul(rows, v) -> tuple[float, float, float]:
     )
 
 
-def _mul_t(rows, s):
+def _mul_t(rows: Rows, s: Vec3) -> Vec3:
     """``R.T @ s``."""
     s0, s1, s2 = s
     r0, r1, r2 = rows
@@ -136,7 +143,7 @@ def _mul_t(rows, s):
     )
 
 
-def normalized_frame(d_start, d_next=None) -> np.ndarray:
+def normalized_frame(d_start: Vector, d_next: Vector | None = None) -> np.ndarray:
     """Rotation matrix ``R`` of ``S_i``: ``R @ v`` are the components of world ``v`` in ``S_i``.
 
     ``R @ d_start = |d_start|/sqrt3 (1, 1, 1)``; ``R @ d_next`` lies in the plane of
@@ -152,7 +159,7 @@ def normalized_frame(d_start, d_next=None) -> np.ndarray:
     return np.array(out[0])
 
 
-def turn_angle(d_start, d_next) -> float:
+def turn_angle(d_start: Vector, d_next: Vector) -> float:
     """Angle between ``D_i(0)`` and ``Delta_{i+1}(0)`` (0 if either is zero)."""
     a0, a1, a2 = _vec3(d_start, "d_start")
     b0, b1, b2 = _vec3(d_next, "d_next")
@@ -215,12 +222,12 @@ def _negligible(nxt: tuple[float, float, float], d: tuple[float, float, float]) 
 
 
 def course_end_velocity(
-    d_start,
-    d_next,
+    d_start: Vector,
+    d_next: Vector | None,
     t_course: float,
     t_next: float | None,
     *,
-    end_velocity=None,
+    end_velocity: Vector | None = None,
     c_low: float = C_LOW,
     c_high: float = C_HIGH,
     k_min: float = K_MIN,
@@ -289,7 +296,9 @@ def course_end_velocity(
     return v, EndVelocity(v, np.array(rows), np.array(rho), np.array(ks), angle, within, rule)
 
 
-def condition_14(end_velocity, d_next, t_next: float, d_after=None) -> bool:
+def condition_14(
+    end_velocity: Vector, d_next: Vector, t_next: float, d_after: Vector | None = None
+) -> bool:
     """Eq. 14: in ``S_{i+1}`` every component of the incoming velocity is slower than the
     next course's average, ``-D'_{i+1,j}(0) < D_{i+1,j}(0) / t_{i+1}``."""
     frame = normalized_frame(d_next, d_after)
@@ -303,7 +312,9 @@ class FrameCourse:
 
     __slots__ = ("profiles", "duration", "_rows")
 
-    def __init__(self, frame, profiles: Sequence, duration: float) -> None:
+    def __init__(
+        self, frame: np.ndarray | Rows, profiles: Sequence[Profile], duration: float
+    ) -> None:
         """``frame``: ``S_i`` as a 3x3 array or as a tuple of three row tuples."""
         rows = frame.tolist() if isinstance(frame, np.ndarray) else frame
         self._rows = tuple(tuple(float(x) for x in r) for r in rows)
@@ -326,7 +337,7 @@ class FrameCourse:
             np.array(_mul_t(rows, (s0[2], s1[2], s2[2]))),
         )
 
-    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World ``(D, D', D'')`` at an array of times: each of shape ``t.shape + (3,)``."""
         parts = [p.evaluate(t) for p in self.profiles]
         out = []
@@ -348,7 +359,11 @@ _IDENTITY_ROWS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 def solve_course_in_frame(
-    frame: np.ndarray | None, deviation_now, velocity_now, time_left: float, end_velocity
+    frame: np.ndarray | Rows | None,
+    deviation_now: Vector,
+    velocity_now: Vector,
+    time_left: float,
+    end_velocity: Vector,
 ) -> FrameCourse:
     """Solve the rest of a course from the current state (what a stateless expert calls).
 
@@ -379,8 +394,9 @@ def solve_course_in_frame(
 
 
 def next_deviation(
-    rows, deviation_now, velocity_now, time_left: float, end_velocity, t: float
-) -> tuple[float, float, float]:
+    rows: Rows, deviation_now: Vec3, velocity_now: Vec3, time_left: float, end_velocity: Vec3,
+    t: float,
+) -> Vec3:  # fmt: skip
     """World ``D(t)`` of the course :func:`solve_course_in_frame` would return, in plain floats.
 
     ``rows``: ``S_i`` as three row tuples (the identity for a dwell), the 3-vectors as tuples
@@ -395,7 +411,9 @@ def next_deviation(
     return _mul_t(rows, (p0.state(t)[0], p1.state(t)[0], p2.state(t)[0]))
 
 
-def _component_profiles(d, v, ve, time_left: float) -> tuple:
+def _component_profiles(
+    d: Vec3, v: Vec3, ve: Vec3, time_left: float
+) -> tuple[Profile, Profile, Profile]:
     """The three component profiles of a course in ``S_i`` (components given in ``S_i``)."""
     rest = ve == _ZERO3
     if rest and d == _ZERO3 and v == _ZERO3:
@@ -408,7 +426,9 @@ def _component_profiles(d, v, ve, time_left: float) -> tuple:
     )
 
 
-def _component_profile(dj: float, vj: float, vej: float, time_left: float, rest: bool):
+def _component_profile(
+    dj: float, vj: float, vej: float, time_left: float, rest: bool
+) -> CourseProfile | HermiteProfile:
     """SGC where it applies, else the Hermite cubic (rules in :func:`solve_course_in_frame`)."""
     k = -vej * time_left / dj if dj != 0.0 else 0.0
     if rest or k <= 0.0:

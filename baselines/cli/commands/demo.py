@@ -12,13 +12,19 @@ import argparse
 import time
 from pathlib import Path
 
+from baselines.cli.checks import bounded_int, out_dir, staged_output
+
 __all__ = ["add_arguments", "run"]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", type=Path, default=Path("runs/demo"), help="output folder")
-    parser.add_argument("--width", type=int, default=960, help="video width in pixels")
-    parser.add_argument("--height", type=int, default=540, help="video height in pixels")
+    parser.add_argument("--out", type=out_dir, default=Path("runs/demo"), help="output folder")
+    parser.add_argument(
+        "--width", type=bounded_int(16, 4096), default=960, help="video width in pixels"
+    )
+    parser.add_argument(
+        "--height", type=bounded_int(16, 4096), default=540, help="video height in pixels"
+    )
     parser.add_argument(
         "--no-video", action="store_true", help="skip rendering (scorecard and plots only)"
     )
@@ -32,16 +38,19 @@ def run(args: argparse.Namespace) -> int:
     from baselines.cli.demo import DemoOptions, run_demo
 
     console = Console()
-    options = DemoOptions(
-        out=args.out, width=args.width, height=args.height, video=not args.no_video
-    )
     started = time.perf_counter()
-    with Progress(
+    # Written next to --out and moved in at the end: an interrupted run leaves the earlier
+    # results whole (no half-written video beside old plates).
+    with staged_output(args.out) as stage, Progress(
         TextColumn("three rods"), BarColumn(), TextColumn("{task.completed}/{task.total} ticks"),
         TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
+        options = DemoOptions(
+            out=stage, width=args.width, height=args.height, video=not args.no_video
+        )
         task = bar.add_task("demo", total=None)
         result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
+        files = sorted(args.out / path.relative_to(stage) for path in result.files.values())
     elapsed = time.perf_counter() - started
 
     table = Table(title="three-rod demo: the expert, scored by the harness")
@@ -63,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
         f"{bool(summary['terminated'])}, {elapsed:.1f} s wall clock"
     )
     console.print(f"outputs in {args.out}/:")
-    for path in sorted(result.files.values()):
+    for path in files:
         console.print(f"  {path}")
     return 0 if summary["goals_met"] == summary["n_goals"] and not summary["terminated"] else 1
 

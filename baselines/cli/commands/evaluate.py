@@ -16,12 +16,24 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from baselines.cli.checks import (
+    known_env_id,
+    nonneg_float,
+    nonneg_int,
+    out_dir,
+    positive_float,
+    positive_int,
+    staged_output,
+)
+from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
 __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
 
 #: (summary key, column title, format) of the comparison table.
 SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("env_id", "env", "s"),
     ("policy", "policy", "s"),
+    ("return_mean", "return", ".1f"),
     ("success_rate", "success", ".2f"),
     ("position_error_max", "pos err max (m)", ".1e"),
     ("orientation_error_max", "ori err max (rad)", ".1e"),
@@ -46,16 +58,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
-    parser.add_argument("--episodes", type=int, default=5, help="episodes per pair (default 5)")
-    parser.add_argument("--seed", type=int, default=1000, help="episode k uses seed + k")
-    parser.add_argument("--out", type=Path, default=None, help="output folder (see above)")
-    parser.add_argument("--tolerance-position", type=float, default=0.02, metavar="M")
-    parser.add_argument("--tolerance-orientation", type=float, default=0.05, metavar="RAD")
     parser.add_argument(
-        "--tolerance-time", type=float, default=None, metavar="S",
+        "--episodes", type=positive_int, default=5, help="episodes per pair (default 5)"
+    )
+    parser.add_argument(
+        "--seed", type=nonneg_int, default=EVAL_SEED,
+        help=f"episode k uses seed + k (default {EVAL_SEED})",
+    )  # fmt: skip
+    parser.add_argument("--out", type=out_dir, default=None, help="output folder (see above)")
+    parser.add_argument(
+        "--tolerance-position", type=positive_float, default=POSITION_TOLERANCE, metavar="M"
+    )
+    parser.add_argument(
+        "--tolerance-orientation", type=positive_float, default=ORIENTATION_TOLERANCE,
+        metavar="RAD",
+    )  # fmt: skip
+    parser.add_argument(
+        "--tolerance-time", type=nonneg_float, default=None, metavar="S",
         help="success time tolerance (default: one control step)",
     )  # fmt: skip
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    parser.add_argument(
+        "--reward", default=None, metavar="MODE",
+        help="the env's reward mode (gym.make(id, reward=MODE): schedule, distance, sparse); "
+        "default: the env's own",
+    )  # fmt: skip
 
 
 def _split(values: Sequence[str] | None, default: str) -> list[str]:
@@ -163,37 +190,43 @@ def run(args: argparse.Namespace) -> int:
         tolerances = Tolerances(
             args.tolerance_position, args.tolerance_orientation, args.tolerance_time
         )
+        for env_id in envs:
+            known_env_id(env_id)
     except ValueError as exc:
         print(f"sgc evaluate: error: {exc}", file=sys.stderr)
         return 2
     single = len(policies) == 1 and len(envs) == 1
+    if single:
+        root = args.out or Path("runs/evaluate") / envs[0] / labels[0]
+    else:
+        root = args.out or Path("runs/evaluate")
     summaries = []
-    for env_id in envs:
-        for spec, label in zip(policies, labels, strict=True):
-            if single:
-                out = args.out or Path("runs/evaluate") / env_id / label
-            else:
-                out = (args.out or Path("runs/evaluate")) / env_id / label
-            try:
-                result = evaluate(
-                    spec, env_id, args.episodes, args.seed, tolerances=tolerances, label=label
-                )
-            except ValueError as exc:
-                print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-                return 2
-            _write_pair(result, out, not args.no_plots)
-            summaries.append(result.summary)
-            if single:
-                console.print(_goal_table(result.rows))
-            console.print(f"[dim]{env_id} / {label}: wrote {out}[/dim]")
+    # Written next to the output folder and moved in at the end: an interrupted run leaves
+    # the earlier results whole.
+    with staged_output(root) as stage:
+        for env_id in envs:
+            for spec, label in zip(policies, labels, strict=True):
+                folder = Path() if single else Path(env_id) / label
+                try:
+                    result = evaluate(
+                        spec, env_id, args.episodes, args.seed, tolerances=tolerances,
+                        label=label,
+                        env_kwargs=None if args.reward is None else {"reward": args.reward},
+                    )  # fmt: skip
+                except ValueError as exc:
+                    print(f"sgc evaluate: error: {exc}", file=sys.stderr)
+                    return 2
+                _write_pair(result, stage / folder, not args.no_plots)
+                summaries.append(result.summary)
+                if single:
+                    console.print(_goal_table(result.rows))
+                console.print(f"[dim]{env_id} / {label}: done, goes to {root / folder}[/dim]")
+        if not single:
+            (stage / "scorecard.json").write_text(
+                json.dumps(json_ready(summaries), indent=2, allow_nan=False) + "\n"
+            )
+            (stage / "scorecard.md").write_text(markdown_table(summaries))
     title = f"{args.episodes} episode(s) from seed {args.seed}"
     console.print(_rich_table(summaries, title))
-    if not single:
-        root = args.out or Path("runs/evaluate")
-        root.mkdir(parents=True, exist_ok=True)
-        (root / "scorecard.json").write_text(
-            json.dumps(json_ready(summaries), indent=2, allow_nan=False) + "\n"
-        )
-        (root / "scorecard.md").write_text(markdown_table(summaries))
-        console.print(f"[dim]wrote {root / 'scorecard.md'} and scorecard.json[/dim]")
+    console.print(f"[dim]wrote {root}[/dim]")
     return 0

@@ -7,7 +7,18 @@ import json
 import shlex
 import sys
 
-from baselines.cli.commands.demos import add_push_arguments, parse_env_kwargs, push_options
+from baselines.cli.checks import (
+    UsageError,
+    env_kwargs,
+    existing_dir,
+    existing_file,
+    known_env_id,
+    nonneg_int,
+    out_dir,
+    positive_int,
+)
+from baselines.cli.commands.demos import add_push_arguments, push_options
+from sgc_env.defaults import EVAL_SEED
 
 ALGOS = ("ppo", "sac", "td3", "her")
 
@@ -15,47 +26,63 @@ ALGOS = ("ppo", "sac", "td3", "her")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--algo", required=True, choices=ALGOS, help="her = SAC + HerReplayBuffer")
     parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v0")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
+    parser.add_argument("--seed", type=nonneg_int, default=0)
     parser.add_argument(
-        "--out", default=None, help="run folder: tb/, checkpoints/, models, config.json"
+        "--timesteps", type=positive_int, default=None, help="override n_timesteps"
     )
+    parser.add_argument(
+        "--out", type=out_dir, default=None,
+        help="run folder: tb/, checkpoints/, models, config.json",
+    )  # fmt: skip
     parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
     parser.add_argument(
-        "--eval-freq", type=int, default=0, help="env steps between harness evaluations (0: off)"
-    )
-    parser.add_argument("--eval-episodes", type=int, default=10)
-    parser.add_argument("--eval-seed", type=int, default=10_000, help="first held-out seed")
+        "--eval-freq", type=nonneg_int, default=0,
+        help="env steps between harness evaluations (0: off)",
+    )  # fmt: skip
+    parser.add_argument("--eval-episodes", type=positive_int, default=10)
     parser.add_argument(
-        "--checkpoint-freq", type=int, default=0, help="env steps between checkpoints (0: off)"
+        "--eval-seed", type=nonneg_int, default=EVAL_SEED, help="first held-out seed"
     )
+    parser.add_argument(
+        "--checkpoint-freq", type=nonneg_int, default=0,
+        help="env steps between checkpoints (0: off)",
+    )  # fmt: skip
     parser.add_argument(
         "--init", choices=("none", "bc"), default="none", help="bc: clone --demos first"
     )
-    parser.add_argument("--demos", default=None, help="npz from `sgc demos`")
-    parser.add_argument("--bc-epochs", type=int, default=30)
+    parser.add_argument("--demos", type=existing_file, default=None, help="npz from `sgc demos`")
+    parser.add_argument("--bc-epochs", type=nonneg_int, default=30)
     parser.add_argument(
         "--bc-log-std", type=float, default=-2.0, help="PPO exploration after cloning"
     )
     parser.add_argument(
-        "--critic-warmup", type=int, default=0,
+        "--critic-warmup", type=nonneg_int, default=0,
         help="env steps of RL with the actor frozen, so the critic learns the clone first",
     )  # fmt: skip
-    parser.add_argument("--dagger-rounds", type=int, default=0, help="DAgger rounds after cloning")
-    parser.add_argument("--dagger-episodes", type=int, default=20, help="rollouts per DAgger round")
+    parser.add_argument(
+        "--dagger-rounds", type=nonneg_int, default=0, help="DAgger rounds after cloning"
+    )
+    parser.add_argument(
+        "--dagger-episodes", type=positive_int, default=20, help="rollouts per DAgger round"
+    )
     add_push_arguments(parser)
     parser.add_argument(
-        "--hyperparams", default=None, help="folder of <algo>.yml (default: hyperparams/)"
+        "--hyperparams", type=existing_dir, default=None,
+        help="folder of <algo>.yml (default: hyperparams/)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--env-kwargs", type=env_kwargs, default=None, help="JSON dict passed to gym.make"
     )
-    parser.add_argument("--env-kwargs", default=None, help="JSON dict passed to gym.make")
     parser.add_argument("--device", default="cpu")
-    parser.add_argument("--verbose", type=int, default=0)
+    parser.add_argument("--verbose", type=nonneg_int, default=0)
 
 
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.train import TrainConfig, train
 
-    env_kwargs = parse_env_kwargs(args.env_kwargs)
+    known_env_id(args.env)
+    if args.init == "bc" and args.demos is None:
+        raise UsageError("--init bc needs --demos (an npz from `sgc demos`)")
     pushes = {f"push_{key}": value for key, value in push_options(args).items()}
     cfg = TrainConfig(
         algo=args.algo, env_id=args.env, seed=args.seed, timesteps=args.timesteps,
@@ -64,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         demos=args.demos, bc_epochs=args.bc_epochs, bc_log_std=args.bc_log_std,
         critic_warmup=args.critic_warmup,
         dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
-        hyperparams_dir=args.hyperparams, env_kwargs=env_kwargs, device=args.device,
+        hyperparams_dir=args.hyperparams, env_kwargs=args.env_kwargs or {}, device=args.device,
         checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
         command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip

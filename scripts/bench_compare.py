@@ -1,0 +1,93 @@
+"""Env step cost of two checkouts in one process, interleaved: is a refactor's hot path as fast?
+
+Imports ``sgc_env`` of ``--reference`` (another worktree, e.g. ``git worktree add /tmp/base
+<commit>``), keeps its env class, then imports this checkout's ``sgc_env`` in its place. For
+every registered id both envs run the same scenario under a hover action in alternating chunks
+(``--rounds`` each, the order flipped every round). The best chunk per side is kept, in wall
+time and in process CPU time, so a busy, shared machine only ever slows a chunk down and both
+sides see the same machine. Prints microseconds per step for both and the cost ratio
+new / reference (1.000 = same cost).
+
+    .venv/bin/python scripts/bench_compare.py --reference /tmp/base [--rounds 40 --chunk 500]
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from bench_env import hover_action  # scripts/ is on the path when run as a script
+
+HERE = Path(__file__).resolve().parents[1]
+
+
+def load_sgc_env(checkout: Path) -> Any:
+    """``sgc_env`` imported from ``checkout``, after forgetting any other copy's modules."""
+    for name in [m for m in sys.modules if m == "sgc_env" or m.startswith("sgc_env.")]:
+        del sys.modules[name]
+    sys.path.insert(0, str(checkout))
+    try:
+        package = importlib.import_module("sgc_env")
+        importlib.import_module("sgc_env.envs")
+    finally:
+        sys.path.remove(str(checkout))
+    return package
+
+
+def chunk_us(env: Any, steps: int, action: np.ndarray) -> tuple[float, float]:
+    """(wall, CPU) microseconds per env.step over ``steps`` steps (resets included, rare)."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    for _ in range(steps):
+        _, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            env.reset(options={"scenario": env.scenario})
+    return (time.perf_counter() - wall) / steps * 1e6, (time.process_time() - cpu) / steps * 1e6
+
+
+def fixed_env(package: Any, kwargs: dict[str, Any]) -> Any:
+    """An SGCEnv of ``package`` on the scenario the registered kwargs give at seed 0."""
+    made = package.envs.SGCEnv(**kwargs)
+    made.reset(seed=0)
+    env = package.envs.SGCEnv(made.scenario)
+    made.close()
+    env.reset()
+    return env
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--reference", type=Path, required=True, help="the other checkout")
+    parser.add_argument("--rounds", type=int, default=40)
+    parser.add_argument("--chunk", type=int, default=500, help="steps per timed chunk")
+    args = parser.parse_args()
+    reference = load_sgc_env(args.reference.resolve())
+    new = load_sgc_env(HERE)
+    registry = {k: v for k, v in new._REGISTRY.items() if v[0].endswith(":SGCEnv")}
+    print(
+        f"{'id':18} {'ref us/step':>12} {'new us/step':>12} {'wall new/ref':>13} "
+        f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12}"
+    )
+    for env_id, (_, kwargs) in registry.items():
+        envs = {"ref": fixed_env(reference, kwargs), "new": fixed_env(new, kwargs)}
+        action = hover_action(envs["new"])
+        best = {side: [float("inf"), float("inf")] for side in envs}
+        for r in range(args.rounds):
+            for side in ("ref", "new") if r % 2 == 0 else ("new", "ref"):  # ABBA: no order bias
+                wall, cpu = chunk_us(envs[side], args.chunk, action)
+                best[side] = [min(best[side][0], wall), min(best[side][1], cpu)]
+        (rw, rc), (nw, nc) = best["ref"], best["new"]
+        print(
+            f"{env_id:18} {rw:12.1f} {nw:12.1f} {nw / rw:13.3f} {rc:11.1f} {nc:11.1f} "
+            f"{nc / rc:12.3f}"
+        )
+        for env in envs.values():
+            env.close()
+
+
+if __name__ == "__main__":
+    main()
