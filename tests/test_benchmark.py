@@ -123,7 +123,7 @@ def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"env_ids": ["Nope-v0"]}, "unknown env id"),
+        ({"env_ids": ["Nope-v0"]}, "--env: unknown environment"),
         ({"seeds": [0, 0]}, "distinct seeds"),
         ({"seeds": []}, "distinct seeds"),
         ({"eval_episodes": 0}, "--eval-episodes"),

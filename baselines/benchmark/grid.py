@@ -242,7 +242,7 @@ def build_grid(
 ) -> list[RunSpec]:
     """Every (recipe, env, seed), after checking the arguments (``ValueError`` naming them)."""
     from baselines.agents.hyperparams import load_hyperparams
-    from baselines.agents.train import check_env_id
+    from sgc_env import check_env_id
 
     if not recipes:
         raise ValueError("recipes: give --algo or --recipes")
@@ -263,7 +263,7 @@ def build_grid(
         raise ValueError(f"--test-seed {test_seed}: its episodes overlap the curve's seeds from "
                          f"{eval_seed}; held-out scoring needs seeds of its own")  # fmt: skip
     for env_id in env_ids:
-        check_env_id(env_id)
+        check_env_id(env_id, "--env")
         for recipe in recipes:
             load_hyperparams(recipe.algo, env_id, recipe.hyperparams)  # fails early, naming it
     return [

@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from baselines.cli.commands.demos import parse_env_kwargs
+from baselines.cli.checks import env_kwargs
 
 __all__ = ["add_arguments", "run"]
 
@@ -32,7 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                          help="recipes file: recipes: [{name, algo, hyperparams, timesteps, "
                          "env_kwargs, train}]")  # fmt: skip
     recipes.add_argument("--hyperparams", default=None, help="folder of <algo>.yml for --algo")
-    recipes.add_argument("--env-kwargs", default=None, help="JSON dict for gym.make (--algo)")
+    recipes.add_argument(
+        "--env-kwargs", type=env_kwargs, default=None, help="JSON dict for gym.make (--algo)"
+    )
     recipes.add_argument("--timesteps", type=int, default=None, help="steps per run (--algo)")
     parser.add_argument("--env", action="append", required=True, metavar="ID",
                         help="env id; repeat or comma-separate")  # fmt: skip
@@ -85,8 +87,7 @@ def _grid(args: argparse.Namespace) -> list[Any]:
 
     recipes = []
     if args.algo:
-        env_kwargs = parse_env_kwargs(args.env_kwargs)
-        recipes += recipes_from_algos(_split(args.algo), args.hyperparams, env_kwargs,
+        recipes += recipes_from_algos(_split(args.algo), args.hyperparams, args.env_kwargs,
                                       args.timesteps)  # fmt: skip
     if args.recipes:
         recipes += load_recipes(args.recipes)
