@@ -174,7 +174,7 @@ def plot_speed_profile(
         if np.max(omega, initial=0.0) > 1e-9:
             ax.plot(t, omega, label="|omega| (rad/s)", alpha=0.6, color="0.45", linewidth=0.9)
         _mark_goals(ax, _goal_times(goals, b))
-        ax.set_ylabel(labels[b], color=color)
+        ax.set_ylabel(labels[b], **({} if color is None else {"color": color}))
         ax.legend(fontsize=7, loc="upper right")
     axes[-1].set_xlabel("time (s)")
     axes[0].set_title(title or "speed profile (goal times dotted)")
@@ -217,7 +217,7 @@ def plot_deviation_components(
                 ax.plot(t, values[:, j], color=color, label="xyz"[j], linewidth=1.0)
             _mark_goals(ax, _goal_times(goals, b))
             ax.axhline(0.0, color="k", linewidth=0.5)
-            ax.set_ylabel(f"{labels[b]} {name}", color=None if colors is None else colors[b])
+            ax.set_ylabel(f"{labels[b]} {name}", **({} if colors is None else {"color": colors[b]}))
             ax.legend(fontsize=7, loc="upper right")
     for ax in axes[-1]:
         ax.set_xlabel("time (s)")
