@@ -80,7 +80,7 @@ def held_out_result(
 
     summary = evaluate(str(model), env_id, episodes, seed, env_kwargs=env_kwargs, keep_infos=0)
     return json_ready(
-        {"episodes": episodes, "seed": seed, **{k: summary.summary[k] for k in RESULT_KEYS}}
+        {"episodes": episodes, "seed": seed, **{k: dict(summary.summary)[k] for k in RESULT_KEYS}}
     )
 
 

@@ -95,7 +95,7 @@ def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str
             mine = [r for r in runs if r["spec"]["env_id"] == env_id
                     and r["spec"]["recipe"]["name"] == row["recipe"]]  # fmt: skip
             scores = [r["scores"]["final"].get("success_rate") or 0.0 for r in mine]
-            prof = performance_profile([scores], taus)
+            prof = performance_profile([scores], [float(t) for t in taus])
             (line,) = ax_p.plot(prof["tau"], prof["fraction"], label=row["recipe"])
             ax_p.fill_between(prof["tau"], prof["low"], prof["high"], alpha=0.2,
                               color=line.get_color())  # fmt: skip

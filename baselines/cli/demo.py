@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -122,7 +122,7 @@ class DemoScene:
                 ball_at = centre + axis @ along
             else:
                 ball_at = np.asarray(ball.position_at(now))
-            self.sim.move(ball_uid, ball_at)
+            self.sim.move(ball_uid, ball_at.tolist())
             casters.append(Caster(ball_at, None, float(ball.size[0])))
         return casters
 
@@ -165,21 +165,22 @@ def run_demo(
     started = cpu_seconds()
     options.out.mkdir(parents=True, exist_ok=True)
     env = gym.make(ENV_ID)
-    base = env.unwrapped
+    base: Any = env.unwrapped
     scenario = base.scenario
     total = base.max_steps
     frame_every = round(base.control_frequency / VIDEO_FPS)
-    frames: list[np.ndarray] = []
+    frames: list[Any] = []
     frame_times: list[float] = []
     tips: list[np.ndarray] = []
     tip_times: list[float] = []
-    scene = painter = None
+    scene: Any = None
+    painter: Any = None
     if options.video:
         scene = DemoScene(base.sim, scenario)
         nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
         painter = DemoPainter(base.sim.client, [b.color for b in scenario.bodies], nails)
 
-    def on_step(env_: Any, step: int, info: dict[str, Any]) -> None:
+    def on_step(env_: Any, step: int, info: Mapping[str, Any]) -> None:
         now = float(info.get("time", 0.0))
         tips.append(np.asarray(info["point_position"], float))
         tip_times.append(now)
@@ -220,7 +221,7 @@ def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trai
     return [Trail(recent[:, b], stamps) for b in range(recent.shape[1])]
 
 
-def _per_rod(record: Any, rows: Sequence[dict[str, Any]], scenario: Any) -> list[dict[str, Any]]:
+def _per_rod(record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any) -> list[dict[str, Any]]:
     """Exactness, punctuality and smoothness for each rod, from the harness's rows and card."""
     out = []
     for b, body in enumerate(scenario.bodies):
@@ -250,7 +251,7 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
     from baselines.cli.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
 
     traj = trajectory_arrays(record.infos, record.initial_info)
-    bodies = {"names": [b.name for b in scenario.bodies],
+    bodies: dict[str, Any] = {"names": [b.name for b in scenario.bodies],
               "colors": [tuple(b.color[:3]) for b in scenario.bodies], "layout": None}  # fmt: skip
     return {
         "deviation.png": plot_deviation_components(
@@ -269,7 +270,7 @@ def gif_durations(count: int, fps: float) -> list[int]:
     return np.diff(np.r_[0, ends]).tolist()
 
 
-def _videos(frames: list[np.ndarray], times: list[float], options: DemoOptions) -> dict[str, Path]:
+def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
 
     mp4 = options.out / "three_rods.mp4"

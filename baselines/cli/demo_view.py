@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import cv2
 import numpy as np
@@ -61,9 +62,9 @@ class Caster:
         """Outline of the shadow on the floor ``z = 0`` (n, 3)."""
         if self.corners is not None:
             flat = _to_floor(self.corners)[:, :2].astype(np.float32)
-            hull = cv2.convexHull(flat)[:, 0, :]
+            hull = cast(np.ndarray, cv2.convexHull(flat))[:, 0, :]
             return np.c_[hull, np.zeros(len(hull))]
-        a = _to_floor(self.a[None])[0]
+        a = _to_floor(cast(np.ndarray, self.a)[None])[0]  # a rod or ball shadow has its a
         b = a if self.b is None else _to_floor(self.b[None])[0]
         ring = np.linspace(0.0, 2.0 * np.pi, 14, endpoint=False)
         circle = self.radius * np.c_[np.cos(ring), np.sin(ring), np.zeros_like(ring)]
@@ -82,7 +83,7 @@ def _floor_texture() -> tuple[np.ndarray, np.ndarray]:
     """One 2x2-tile period of the checker (BGR-free RGB uint8) and its texel->world map."""
     px = 64
     half = px // 2
-    tex = np.empty((px, px, 3), np.uint8)
+    tex: np.ndarray = np.empty((px, px, 3), np.uint8)
     tex[:] = FLOOR_LIGHT
     tex[:half, :half] = FLOOR_DARK
     tex[half:, half:] = FLOOR_DARK
@@ -154,7 +155,7 @@ class DemoPainter:
             self._texture, to_pixel @ self._tex_to_world, (hw, hh),
             flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_WRAP,
         ).astype(np.float32)  # fmt: skip
-        shade = np.zeros((hh, hw), np.uint8)
+        shade: np.ndarray = np.zeros((hh, hw), np.uint8)
         for caster in casters:
             outline, depth = view.project(caster.ground_outline())
             if np.all(depth > 0.0):
