@@ -1,14 +1,16 @@
 """Shared fixtures: every env a test makes is closed when the test ends.
 
-An unclosed env keeps its PyBullet client (and its memory) until the process exits, so a
-suite that forgets ``close()`` grows with every test. :func:`closing_every_env` records each
-:class:`~sgc_env.envs.SGCEnv` constructed while it is active (``gym.make`` ones included) and
-closes those still open on exit; the autouse fixture wraps every test in it.
+An unclosed env keeps its PyBullet client (and its memory) until it is collected, so a suite
+that forgets ``close()`` grows with every test. :func:`closing_every_env` records each
+:class:`~sgc_env.envs.SGCEnv` constructed while it is active (``gym.make`` ones included),
+weakly, so that envs a test drops are still collected (and freed) as usual, and closes those
+still alive and open on exit; the autouse fixture wraps every test in it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import weakref
 from collections.abc import Iterator
 
 import pytest
@@ -17,13 +19,13 @@ from sgc_env.envs import SGCEnv
 
 
 @contextlib.contextmanager
-def closing_every_env() -> Iterator[list[SGCEnv]]:
+def closing_every_env() -> Iterator[weakref.WeakSet[SGCEnv]]:
     """Track the SGCEnv instances constructed inside the block; close the open ones after."""
-    made: list[SGCEnv] = []
+    made: weakref.WeakSet[SGCEnv] = weakref.WeakSet()
     original = SGCEnv.__init__
 
     def tracking_init(self: SGCEnv, *args: object, **kwargs: object) -> None:
-        made.append(self)  # before building: a constructor that fails is cleaned up too
+        made.add(self)  # before building: a constructor that fails is cleaned up too
         original(self, *args, **kwargs)
 
     SGCEnv.__init__ = tracking_init  # type: ignore[method-assign]
@@ -31,12 +33,11 @@ def closing_every_env() -> Iterator[list[SGCEnv]]:
         yield made
     finally:
         SGCEnv.__init__ = original  # type: ignore[method-assign]
-        for env in made:
-            if getattr(env, "sim", None) is not None:
-                env.close()
+        for env in list(made):
+            env.close()  # idempotent, and safe on an env whose constructor failed
 
 
 @pytest.fixture(autouse=True)
-def close_envs() -> Iterator[list[SGCEnv]]:
+def close_envs() -> Iterator[weakref.WeakSet[SGCEnv]]:
     with closing_every_env() as made:
         yield made
