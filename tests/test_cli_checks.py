@@ -43,7 +43,7 @@ BAD = [
     ([*DEMOS, "--out", "{tmp}/d.npz", "--push-scale", "-1"], "expected a number >= 0"),
     (["demos", "--env", "Nope-v0", "--episodes", "1", "--out", "{tmp}/d.npz"], "--env:"),
     ([*TRAIN, "--seed", "-1"], "argument --seed"),
-    ([*TRAIN, "--timesteps", "0"], "argument --timesteps"),
+    ([*TRAIN, "--timesteps", "-1"], "argument --timesteps"),
     ([*TRAIN, "--out", "{file}"], "exists and is not a folder"),
     ([*TRAIN, "--demos", "{tmp}/none.npz"], "no such file"),
     ([*TRAIN, "--hyperparams", "{tmp}/none"], "no such folder"),

@@ -28,8 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v0")
     parser.add_argument("--seed", type=nonneg_int, default=0, help="training seed")
     parser.add_argument(
-        "--timesteps", type=positive_int, default=None,
-        help="override n_timesteps (rounded up to whole rollouts, with a note)",
+        "--timesteps", type=nonneg_int, default=None,
+        help="override n_timesteps (rounded up to whole rollouts, with a note; 0 with --init bc "
+        "scores the clone without RL)",
     )  # fmt: skip
     parser.add_argument(
         "--out", type=out_dir, default=None,
