@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -131,7 +131,10 @@ def plot_goal_errors(rows: Sequence[Mapping[str, Any]], path: str | Path, title:
     return _save(fig, path)
 
 
-def _figure(size: tuple[float, float], layout: str | None) -> Figure:
+Layout = Literal["constrained", "compressed", "tight"] | None
+
+
+def _figure(size: tuple[float, float], layout: Layout) -> Figure:
     """A figure; ``layout=None`` uses fixed margins (matplotlib's layout engines cost about
     1.5 s of CPU per multi-row figure, a third of the demo's plotting)."""
     fig = Figure(figsize=size, layout=layout)
@@ -156,7 +159,7 @@ def plot_speed_profile(
     title: str = "",
     names: Sequence[str] | None = None,
     colors: Sequence[Any] | None = None,
-    layout: str | None = "constrained",
+    layout: Layout = "constrained",
 ) -> Path:
     """Tracked-point speed (and |omega|) against time, goal times dotted, per body.
 
@@ -188,7 +191,7 @@ def plot_deviation_components(
     title: str = "",
     names: Sequence[str] | None = None,
     colors: Sequence[Any] | None = None,
-    layout: str | None = "constrained",
+    layout: Layout = "constrained",
 ) -> Path:
     """Each component of D (and phi where present) against time, goal times dotted.
 
