@@ -23,6 +23,7 @@ import os
 import subprocess
 import sys
 import time
+from typing import Any
 
 import numpy as np
 
@@ -86,7 +87,7 @@ def main() -> None:
     w, h, n = args.width, args.height, args.frames
     env = gym.make("SGCThreeRods-v0")
     env.reset(seed=0)
-    base = env.unwrapped
+    base: Any = env.unwrapped  # the SGCEnv
     client = base.sim.client
     scene = DemoScene(base.sim, base.scenario)
     casters = scene.update(2.0)
@@ -137,7 +138,9 @@ def main() -> None:
         capture_output=True, text=True, env={**os.environ}, timeout=600,
     )  # fmt: skip
     lines = [ln for ln in child.stdout.splitlines() if ln.startswith("{")]
-    egl = json.loads(lines[-1]) if lines else {"error": child.stderr.strip()[-200:]}
+    egl: dict[str, Any] = (
+        json.loads(lines[-1]) if lines else {"error": child.stderr.strip()[-200:]}
+    )
 
     print(f"{w}x{h}, mean of {n} frames, CPU s per frame (ratio to the reference)")
     for name, seconds in rows.items():
@@ -145,7 +148,7 @@ def main() -> None:
     if "error" in egl:
         print(f"  EGL plugin: did not run ({egl['error']})")
     else:
-        s = egl["egl_shadow"]
+        s = float(egl["egl_shadow"])
         print(f"  {'EGL plugin (llvmpipe), shadow=1, child process':62s} {s:7.4f}  "
               f"({s / reference:5.2f}x)")  # fmt: skip
 

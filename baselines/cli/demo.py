@@ -122,7 +122,7 @@ class DemoScene:
                 ball_at = centre + axis @ along
             else:
                 ball_at = np.asarray(ball.position_at(now))
-            self.sim.move(ball_uid, ball_at.tolist())
+            self.sim.move(ball_uid, tuple(ball_at.tolist()))
             casters.append(Caster(ball_at, None, float(ball.size[0])))
         return casters
 
@@ -165,7 +165,7 @@ def run_demo(
     started = cpu_seconds()
     options.out.mkdir(parents=True, exist_ok=True)
     env = gym.make(ENV_ID)
-    base: Any = env.unwrapped
+    base: Any = env.unwrapped  # the SGCEnv: scenario, sim, max_steps
     scenario = base.scenario
     total = base.max_steps
     frame_every = round(base.control_frequency / VIDEO_FPS)
@@ -184,7 +184,7 @@ def run_demo(
         now = float(info.get("time", 0.0))
         tips.append(np.asarray(info["point_position"], float))
         tip_times.append(now)
-        if painter is not None and step % frame_every == 0:
+        if painter is not None and scene is not None and step % frame_every == 0:
             casters = scene.update(now)
             view = camera_at(now, options.width, options.height)
             frames.append(painter.frame(view, _trails(tips, tip_times, now), casters, now))
@@ -221,7 +221,9 @@ def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trai
     return [Trail(recent[:, b], stamps) for b in range(recent.shape[1])]
 
 
-def _per_rod(record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any) -> list[dict[str, Any]]:
+def _per_rod(
+    record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any
+) -> list[dict[str, Any]]:
     """Exactness, punctuality and smoothness for each rod, from the harness's rows and card."""
     out = []
     for b, body in enumerate(scenario.bodies):
@@ -251,15 +253,17 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
     from baselines.cli.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
 
     traj = trajectory_arrays(record.infos, record.initial_info)
-    bodies: dict[str, Any] = {"names": [b.name for b in scenario.bodies],
-              "colors": [tuple(b.color[:3]) for b in scenario.bodies], "layout": None}  # fmt: skip
+    names = [b.name for b in scenario.bodies]
+    colors = [tuple(b.color[:3]) for b in scenario.bodies]
     return {
         "deviation.png": plot_deviation_components(
             traj, record.goals, out / "deviation.png",
             title="three rods: deviation of each tip (D) and orientation (phi), goal times dotted",
-            **bodies,
+            names=names, colors=colors, layout=None,
         ),
-        "speed.png": plot_speed_profile(traj, record.goals, out / "speed.png", **bodies),
+        "speed.png": plot_speed_profile(
+            traj, record.goals, out / "speed.png", names=names, colors=colors, layout=None
+        ),
     }  # fmt: skip
 
 
@@ -274,8 +278,8 @@ def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict
     import imageio.v2 as imageio
 
     mp4 = options.out / "three_rods.mp4"
-    imageio.mimwrite(mp4, frames, fps=VIDEO_FPS, codec="libx264", quality=7, macro_block_size=4,
-                     ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
+    imageio.mimwrite(mp4, list[Any](frames), fps=VIDEO_FPS, codec="libx264", quality=7,
+                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
     gif = options.out / "three_rods.gif"
     step = options.gif_scale
     small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)

@@ -64,7 +64,9 @@ class Caster:
             flat = _to_floor(self.corners)[:, :2].astype(np.float32)
             hull = cast(np.ndarray, cv2.convexHull(flat))[:, 0, :]
             return np.c_[hull, np.zeros(len(hull))]
-        a = _to_floor(cast(np.ndarray, self.a)[None])[0]  # a rod or ball shadow has its a
+        if self.a is None:
+            raise ValueError("Caster: give a point (a), a segment (a, b) or corners")
+        a = _to_floor(self.a[None])[0]
         b = a if self.b is None else _to_floor(self.b[None])[0]
         ring = np.linspace(0.0, 2.0 * np.pi, 14, endpoint=False)
         circle = self.radius * np.c_[np.cos(ring), np.sin(ring), np.zeros_like(ring)]
@@ -162,7 +164,7 @@ class DemoPainter:
                 pts = (outline - [0.0, top]) * 0.5
                 cv2.fillPoly(shade, [np.round(pts * 16).astype(np.int32)], 255,
                              lineType=cv2.LINE_AA, shift=4)  # fmt: skip
-        shade = cv2.GaussianBlur(shade, (0, 0), 1.2).astype(np.float32) / 255.0
+        soft = cv2.GaussianBlur(shade, (0, 0), 1.2).astype(np.float32) / 255.0
         # distance of each floor pixel along the view axis, a ratio of affine functions of
         # the pixel: (x, y, 1) ~ to_world @ (px, py, 1), distance = -(view row 2) @ (x, y, 0, 1)
         to_world = np.linalg.inv(to_pixel)
@@ -173,7 +175,7 @@ class DemoPainter:
         den = to_world[2, 0] * gx + to_world[2, 1] * gy + to_world[2, 2]
         dist = (num[0] * gx + num[1] * gy + num[2]) / den
         haze = np.where(dist > 0.0, -np.expm1(-np.maximum(dist, 0.0) / HAZE), 1.0)
-        lit = checker * (1.0 - (1.0 - SHADOW) * shade)[..., None]
+        lit = checker * (1.0 - (1.0 - SHADOW) * soft)[..., None]
         lit += (SKY_HORIZON.astype(np.float32) - lit) * haze[..., None].astype(np.float32)
         half = np.clip(lit, 0, 255).astype(np.uint8)
         return cv2.resize(half, (w, 2 * hh), interpolation=cv2.INTER_LINEAR)[: h - top]
