@@ -93,7 +93,7 @@ def body_wrench(
     vx, vy, vz = linear_velocity
     accel = held_acceleration_for_position  # per component: plain floats, no arrays
     return (
-        mass * (accel(0.0, vx, dx - (ax - bx), h, n) - gx),
-        mass * (accel(0.0, vy, dy - (ay - by), h, n) - gy),
-        mass * (accel(0.0, vz, dz - (az - bz), h, n) - gz),
+        mass * (float(accel(0.0, vx, dx - (ax - bx), h, n)) - gx),
+        mass * (float(accel(0.0, vy, dy - (ay - by), h, n)) - gy),
+        mass * (float(accel(0.0, vz, dz - (az - bz), h, n)) - gz),
     ), torque

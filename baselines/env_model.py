@@ -12,8 +12,10 @@ from typing import Any
 
 import numpy as np
 
+from baselines.vector import base_env
 from sgc_env.observation import ObservationLayout
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE
 
 __all__ = ["BodyModel", "EnvModel"]
 
@@ -27,7 +29,7 @@ class BodyModel:
     force_limit: float
     torque_limit: float
     torque_scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    """N m per unit of torque action about each principal axis (``env.torque_scale``)."""
+    """N m per unit of torque action along each principal axis (``env.torque_scale``)."""
 
 
 @dataclass(frozen=True)
@@ -40,6 +42,8 @@ class EnvModel:
     sim_dt: float
     substeps: int
     use_torque: bool
+    end_rule: str = DEFAULT_END_RULE
+    """The scenario's ``end_velocity_rule``: how a planner ends an interior course."""
 
     @property
     def control_dt(self) -> float:
@@ -48,7 +52,7 @@ class EnvModel:
     @classmethod
     def from_env(cls, env: Any) -> EnvModel:
         """Read the model of a Gymnasium env (wrapped or not) or of a vector env's first env."""
-        base = _unwrap(env)
+        base = base_env(env)
         scenario = base.scenario
         bodies = tuple(
             BodyModel(
@@ -69,6 +73,7 @@ class EnvModel:
             sim_dt=1.0 / float(base.sim_frequency),
             substeps=int(base.substeps),
             use_torque=bool(base.use_torque),
+            end_rule=scenario.end_velocity_rule,
         )
 
     def action_from_wrenches(self, forces, torques, orientations) -> np.ndarray:
@@ -76,12 +81,12 @@ class EnvModel:
 
         ``forces`` and ``torques``: arrays of shape (n, 3) or sequences of 3-tuples (the
         expert passes tuples; plain floats keep its control step cheap). ``orientations``:
-        each body's quaternion (xyzw) at the start of the step, which the env uses to turn the
-        body-axis torque action into a world torque (``R0 (torque_scale * a)``); here the
-        inverse, ``R0^T tau / torque_scale``, so the env applies exactly ``tau``. The action is
-        float64 on purpose: the env uses whatever precision it is given, and rounding the torque
-        to the float32 of the action space moved a thin rod's orientation at a goal by up to
-        ~1e-9 rad under world-frame torques.
+        each body's quaternion (xyzw) at the start of the step, with which the env scales the
+        torque action per principal axis (``tau = R0 diag(torque_scale) R0^T a``); here the
+        inverse, ``a = R0 diag(1 / torque_scale) R0^T tau``, so the env applies ``tau``. The
+        action is float64 on purpose: the env uses whatever precision it is given, and rounding
+        the torque to the float32 of the action space moved a thin rod's orientation at a goal
+        by up to ~1e-9 rad under unscaled world-frame torques.
         """
         n = len(self.bodies)
         if isinstance(forces, np.ndarray):
@@ -97,19 +102,7 @@ class EnvModel:
             out += (force[0] / f_lim, force[1] / f_lim, force[2] / f_lim)
             if use_torque:
                 sx, sy, sz = body.torque_scale
-                x, y, z, w = q
-                bx, by, bz = quat.rotate((-x, -y, -z, w), torque)
-                out += (bx / sx, by / sy, bz / sz)
+                bx, by, bz = quat.rotate_back(q, torque)
+                out += quat.rotate(q, (bx / sx, by / sy, bz / sz))
         return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
 
-
-def _unwrap(env: Any) -> Any:
-    """The base SGC env behind wrappers, or behind the first sub-env of a vector env."""
-    if hasattr(env, "get_attr") and not hasattr(env, "unwrapped"):
-        return env.get_attr("unwrapped", [0])[0]
-    if hasattr(env, "envs"):
-        return env.envs[0].unwrapped
-    base = env.unwrapped
-    if not hasattr(base, "scenario"):
-        raise TypeError(f"{type(base).__name__} is not an SGC environment (no scenario)")
-    return base

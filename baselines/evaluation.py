@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
@@ -183,7 +183,7 @@ def run_episode(
     tolerances: Tolerances | None = None,
     keep_infos: bool = False,
     max_steps: int = 100_000,
-    frames: list[np.ndarray] | None = None,
+    frames: list[Any] | None = None,
     on_step: Callable[[gym.Env, int, Mapping[str, Any]], None] | None = None,
 ) -> EpisodeRecord:
     """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
@@ -215,7 +215,7 @@ def run_episode(
             on_step(env, len(infos), info)
         if terminated or truncated:
             break
-    base = env.unwrapped
+    base: Any = env.unwrapped
     goals = goals_from_scenario(base.scenario)
     card = score_episode(infos, goals, base.dt, tolerances, initial_info=initial_info)
     return EpisodeRecord(
@@ -341,14 +341,14 @@ def _resolve_policy(
     if isinstance(policy, str):
         return make_policy(policy, env, seed=seed), policy_label(policy)
     if isinstance(policy, type) or (callable(policy) and not hasattr(policy, "predict")):
-        built = policy(env)
+        built = cast(Callable[[Any], Policy], policy)(env)
         return built, type(built).__name__
     if not hasattr(policy, "predict"):
         raise ValueError(
             f"policy must be a spec string, an object with .predict or a factory of one, "
             f"got {type(policy).__name__}"
         )
-    return policy, type(policy).__name__
+    return cast(PolicyLike, policy), type(policy).__name__
 
 
 def evaluate(
@@ -395,12 +395,9 @@ def evaluate(
     finally:
         env.close()
     rows = [row for r in records for row in goal_rows(r, env_id, name)]
-    summary: Scorecard = {  # type: ignore[typeddict-item]
-        "env_id": env_id,
-        "policy": name,
-        "seed": int(seed),
-        **summarize(records, rows),
-    }
+    summary = cast(
+        Scorecard, {"env_id": env_id, "policy": name, "seed": int(seed), **summarize(records, rows)}
+    )
     return EvaluationResult(env_id, name, int(seed), records, rows, summary)
 
 

@@ -22,6 +22,7 @@ from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
 from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import END_RULES
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
 
@@ -46,9 +47,17 @@ class SGCExpert:
     """
 
     def __init__(
-        self, env: Any | None = None, *, model: EnvModel | None = None, refine: bool = True
+        self,
+        env: Any | None = None,
+        *,
+        model: EnvModel | None = None,
+        refine: bool = True,
+        end_rule: str | None = None,
     ) -> None:
-        """``refine``: give the torque between goals its correction step on the simulated
+        """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
+        :mod:`sgc_env.paper.frames`); None follows the scenario (``model.end_rule``).
+
+        ``refine``: give the torque between goals its correction step on the simulated
         rotation (goal ticks always get the exact Newton).
 
         Measured on SGCRod-v0 and the three-rod demo: the closed-form first guess alone
@@ -63,8 +72,11 @@ class SGCExpert:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
             model = EnvModel.from_env(env)
+        if end_rule is not None and end_rule not in END_RULES:
+            raise ValueError(f"end_rule must be one of {list(END_RULES)}, got {end_rule!r}")
         self.model = model
         self.refine = refine
+        self.end_rule = end_rule
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
         self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
         self._courses: dict[tuple[float, ...], tuple[tuple, tuple]] = {}
@@ -106,6 +118,7 @@ class SGCExpert:
                 (BodyFields(model.layout, i), body) for i, body in enumerate(model.bodies)
             )
             self._fields_of = model
+            self._courses.clear()  # a new model may bring another end rule
         values = observation.tolist()
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError("observation contains non-finite values")
@@ -163,7 +176,7 @@ class SGCExpert:
         key = tuple(o[track.course : track.course + COURSE_SIZE])
         course = self._courses.get(key)
         if course is None:
-            course = _course_constants(key)
+            course = _course_constants(key, self.end_rule or self.model.end_rule)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
@@ -171,7 +184,7 @@ class SGCExpert:
         return next_deviation(rows, deviation, rate, time_left, end_velocity, period)
 
 
-def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
+def _course_constants(key: tuple[float, ...], rule: str) -> tuple[tuple, tuple]:
     """World end velocity and ``S_i`` rows of a course from its observation entries."""
     start, duration, nxt, next_duration, end_velocity = (
         key[0:3], key[3], key[4:7], key[7], key[8:11]
@@ -179,7 +192,7 @@ def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
     is_last = key[12] > 0.5
     velocity, info = course_end_velocity(
         start, None if is_last else nxt, duration, None if is_last else next_duration,
-        end_velocity=end_velocity if is_last else None,
+        end_velocity=end_velocity if is_last else None, rule=rule,
     )  # fmt: skip
     rows = _IDENTITY_ROWS if info.frame is None else tuple(map(tuple, info.frame.tolist()))
     return tuple(velocity.tolist()), rows

@@ -12,6 +12,7 @@ x0 + (x1 - x0)(10 s^3 - 15 s^4 + 6 s^5).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -140,7 +141,7 @@ class MinimumJerkRotation:
                 f"got {len(rotations)}"
             )
         self.start = Rotation.from_quat(quats[0])
-        knots = [np.zeros(3)]
+        knots: list[Any] = [np.zeros(3)]
         for j in range(1, quats.shape[0]):
             rel = (Rotation.from_quat(quats[j]) * self.start.inv()).as_rotvec()
             guess = knots[-1]

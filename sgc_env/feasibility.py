@@ -10,7 +10,7 @@ planner (and scipy) load only when a check runs, so ``import sgc_env`` stays lig
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -67,9 +67,13 @@ def _plan(b: Body, control_frequency: int):
         BodyState(
             vec(b.position), vec(b.orientation), vec(b.linear_velocity), vec(b.angular_velocity)
         ),
-        [PositionGoal(g.time, vec(g.nail), vec(g.point)) for g in b.goals if g.has_position],
         [
-            OrientationGoal(g.time, vec(g.orientation), vec(g.relative_rotation))
+            PositionGoal(cast(float, g.time), vec(g.nail), vec(g.point))  # resolved: timed
+            for g in b.goals
+            if g.has_position
+        ],
+        [
+            OrientationGoal(cast(float, g.time), vec(g.orientation), vec(g.relative_rotation))
             for g in b.goals
             if g.has_orientation
         ],
@@ -98,38 +102,45 @@ def body_demand(scenario: Scenario, b: Body, periods: int | None = None) -> Body
     """Peak demands of body ``b`` of a resolved scenario, per control period up to its last goal.
 
     A zero-order hold applies one force and torque per period, so the demand is the average
-    over a period: ``m (v(t+dt) - v(t)) / dt - m g`` and ``(L(t+dt) - L(t)) / dt`` with the
-    world-frame angular momentum ``L = R I R^T omega``; the instantaneous peak at the end of a
-    course is higher but lasts a fraction of a period. ``periods`` caps how many periods are
-    examined (default ``MAX_DEMAND_PERIODS``; the ones around goal ticks always are). Raises
-    ValueError where the planner cannot plan the goals.
+    over a period: ``|m (v(t+dt) - v(t)) / dt - m g|`` and the torque ``(L(t+dt) - L(t)) / dt``
+    (world angular momentum ``L = R I R^T omega``) taken in the body axes as the env's action
+    is, each axis weighted by ``max(I) / I`` (the env's per-axis torque scale), largest axis;
+    the instantaneous peak at the end of a course is higher but lasts a fraction of a period.
+    ``periods`` caps how many periods are examined (default ``MAX_DEMAND_PERIODS``; the ones
+    around goal ticks always are). Raises ValueError where the planner cannot plan the goals.
     """
     g = np.asarray(scenario.gravity, float)
     low, high = (np.asarray(w, float) for w in scenario.workspace)
     freq = scenario.control_frequency
     dt = 1.0 / freq
     plan = _plan(b, freq)
-    inertia = np.diag(inertia_diagonal(b.shape, b.size, b.mass))
+    moments = inertia_diagonal(b.shape, b.size, b.mass)
+    inertia = np.diag(moments)
+    # The env scales each body axis' torque by I / max(I) (an action of 1 gives the same
+    # angular acceleration about every axis), so a torque about the axis of least inertia
+    # counts max(I) / I times against torque_limit.
+    axis_weight = moments.max() / moments
     goal_ticks = [round(float(gl.time) * freq) for gl in b.goals]  # type: ignore[arg-type]
-    cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+    cache: dict[int, tuple[np.ndarray, ...]] = {}
 
-    def state(k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def state(k: int) -> tuple[np.ndarray, ...]:
         if k not in cache:
             s = plan.sample(k * dt)
             rm = np.asarray(quat.to_matrix(s.orientation), float)
             momentum = rm @ inertia @ rm.T @ s.angular_velocity
-            cache[k] = (s.position, s.velocity, s.angular_velocity, momentum)
+            cache[k] = (s.position, s.velocity, s.angular_velocity, momentum, rm)
         return cache[k]
 
     peaks = dict.fromkeys(("force", "torque", "speed", "spin"), (0.0, 0.0))
     outside = None
     for k in _periods(max(goal_ticks), goal_ticks, periods or MAX_DEMAND_PERIODS):
-        x0, v0, w0, l0 = state(k)
-        x1, v1, w1, l1 = state(k + 1)
+        x0, v0, w0, l0, r0 = state(k)
+        x1, v1, w1, l1, _ = state(k + 1)
         t = (k + 1) * dt
+        body_torque = r0.T @ ((l1 - l0) / dt)  # in the body axes at the period's start
         values = {
             "force": b.mass * float(np.linalg.norm((v1 - v0) / dt - g)),
-            "torque": float(np.linalg.norm((l1 - l0) / dt)),
+            "torque": float(np.max(np.abs(body_torque) * axis_weight)),
             "speed": float(max(np.linalg.norm(v0), np.linalg.norm(v1))),
             "spin": float(max(np.linalg.norm(w0), np.linalg.norm(w1))),
         }

@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from functools import cache
+from typing import Any, cast
 
 import gymnasium as gym
 
@@ -50,8 +51,9 @@ LADDER: tuple[Rung, ...] = (
 
 def _space(space: gym.Space) -> str:
     if isinstance(space, gym.spaces.Dict):
-        return "Dict(" + ", ".join(f"{k} {v.shape[0]}" for k, v in space.spaces.items()) + ")"
-    return f"Box ({space.shape[0]},)"
+        sizes = (f"{k} {cast(tuple, v.shape)[0]}" for k, v in space.spaces.items())
+        return "Dict(" + ", ".join(sizes) + ")"
+    return f"Box ({cast(tuple, space.shape)[0]},)"
 
 
 def _bodies(scenario) -> str:
@@ -75,7 +77,7 @@ def goal_counts(env_id: str, scenario) -> str:
 
 def _row(rung: Rung) -> dict[str, str]:
     env = gym.make(rung.env_id)
-    scenario = env.unwrapped.scenario
+    scenario = cast(Any, env.unwrapped).scenario
     row = {
         "id": f"`{rung.env_id}`",
         "bodies": _bodies(scenario),

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -176,7 +177,7 @@ def random_scenario(rng: np.random.Generator, config: SceneFamily | str = "point
     scenario = Scenario(
         bodies=(body,),
         name="random",
-        workspace=(tuple(start - hw), tuple(start + hw)),  # type: ignore[arg-type]
+        workspace=(tuple(start - hw), tuple(start + hw)),
         margin=cfg.margin,
         control_frequency=f,
     )
@@ -199,10 +200,11 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
 
     where ``j(theta) = (theta e^theta - e^theta + 1) / theta^2`` bounds the rate of ``J_l``
     (its series, term by term). Without an orientation track ``omega`` is the constant
-    initial one. Torque actions act about scaled body axes: the action about principal axis k
-    is ``(I_k alpha_k + gyro_k) / (torque_limit I_k / I_max)`` and ``|gyro_k| <= I_k |omega|^2``
-    (principal moments obey ``I_k >= |I_j - I_l|``), so a torque bound below ``torque_limit``
-    keeps every axis of the scaled action below 1.
+    initial one. The torque action ``R0 diag(1 / torque_scale) R0^T tau`` has principal
+    components ``(I_k alpha_k + gyro_k) / (torque_limit I_k / I_max)`` and
+    ``|gyro_k| <= I_k |omega_j omega_l|`` (principal moments obey ``I_k >= |I_j - I_l|``), so its
+    norm, and every entry, stays below ``torque / torque_limit``: a torque bound below
+    ``torque_limit`` keeps the scaled torque action inside the box.
     """
     from sgc_env.paper.plan import BodyState, OrientationGoal, PlanOptions, PositionGoal, plan_body
 
@@ -215,9 +217,9 @@ def planner_demand(scenario: Scenario, samples: int = 64) -> list[tuple[float, f
                 np.asarray(b.position), np.asarray(b.orientation),
                 np.asarray(b.linear_velocity), np.asarray(b.angular_velocity),
             ),
-            [PositionGoal(gl.time, np.asarray(gl.nail), np.asarray(gl.point))
+            [PositionGoal(cast(float, gl.time), np.asarray(gl.nail), np.asarray(gl.point))
              for gl in b.goals if gl.has_position],
-            [OrientationGoal(gl.time, orientation=None if gl.orientation is None
+            [OrientationGoal(cast(float, gl.time), orientation=None if gl.orientation is None
                              else np.asarray(gl.orientation),
                              relative_rotation=None if gl.relative_rotation is None
                              else np.asarray(gl.relative_rotation))

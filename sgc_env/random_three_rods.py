@@ -97,6 +97,11 @@ class RandomThreeRodsConfig:
         )
 
 
+def _vec3(v: np.ndarray) -> tuple[float, float, float]:
+    x, y, z = (float(c) for c in v)
+    return x, y, z
+
+
 def _on_grid(t: float, frequency: int) -> float:
     return round(t * frequency) / frequency
 
@@ -120,14 +125,12 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     )
     return replace(
         base,
-        waypoints=tuple(tuple(float(c) for c in p) for p in moved),
+        waypoints=tuple(_vec3(p) for p in moved),
         samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
         samples_after=after,
         hit_time=_on_grid(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
         pierce_time=_on_grid(rng.uniform(*cfg.pierce_time), f),
-        ball_velocity=tuple(
-            float(c) for c in direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)
-        ),
+        ball_velocity=_vec3(direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)),
         somersault_sample=None,
     )
 
@@ -172,7 +175,9 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
         if not _enters_board(body, cfg.min_entry_cosine):
             continue
         body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
-        scenario = resolve_scenario(scenario_from_dict(data))
+        # The demand share below is the feasibility check (stricter than resolve_scenario's
+        # plan check, which would run the planner twice and raise instead of redraw).
+        scenario = resolve_scenario(scenario_from_dict(data), check_plan=False)
         ((force, torque),) = planner_demand(scenario)
         if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
             return scenario

@@ -31,6 +31,7 @@ import numpy as np
 import yaml
 
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
 from sgc_env.paper.routing import resolve_goal_times
 
 __all__ = [
@@ -195,6 +196,7 @@ class Scenario:
     margin: float = 0.25
     control_frequency: int = 60
     time_grid: str = "reject"
+    end_velocity_rule: str = DEFAULT_END_RULE
     allow_saturation: bool = False
     resolved: bool = field(default=False, compare=False)
 
@@ -238,7 +240,7 @@ def parametric_curve(kind: str, **params: Any) -> Callable[[float], np.ndarray]:
 
 
 def path_goals(
-    path: Callable[[float], Sequence[float]],
+    path: Callable[[float], Sequence[float] | np.ndarray],
     samples: int,
     *,
     time: float | None = None,
@@ -471,7 +473,7 @@ _BODY_KEYS = {
 _PROP_KEYS = {"name", "shape", "size", "color", "position", "velocity", "waypoints", "collisions"}
 _SCENARIO_KEYS = {
     "name", "bodies", "props", "goals", "gravity", "workspace", "margin", "control_frequency",
-    "time_grid", "allow_saturation",
+    "time_grid", "allow_saturation", "end_velocity_rule",
 }  # fmt: skip
 
 
@@ -607,6 +609,8 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
         kw["time_grid"] = d["time_grid"]
     if "allow_saturation" in d:
         kw["allow_saturation"] = _bool(d["allow_saturation"], "allow_saturation")
+    if "end_velocity_rule" in d:
+        kw["end_velocity_rule"] = d["end_velocity_rule"]
     return Scenario(**kw)
 
 
@@ -624,6 +628,10 @@ def _validate_structure(s: Scenario) -> None:
         raise _fail("bodies", "expected at least one body")
     if s.time_grid not in TIME_GRID_MODES:
         raise _fail("time_grid", f"expected one of {TIME_GRID_MODES}, got {s.time_grid!r}")
+    if s.end_velocity_rule not in END_RULES:
+        raise _fail(
+            "end_velocity_rule", f"expected one of {END_RULES}, got {s.end_velocity_rule!r}"
+        )
     if not (isinstance(s.control_frequency, int) and s.control_frequency > 0):
         raise _fail(
             "control_frequency", f"expected a positive integer, got {s.control_frequency!r}"
@@ -781,7 +789,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
     distances: list[float] = []
     weights: list[float] = []
     prev_point: np.ndarray | None = None
-    prev_q = np.asarray(b.orientation, float)
+    prev_q: Any = np.asarray(b.orientation, float)
     for j, g in enumerate(b.goals):
         gp = f"{p}.goals[{j}]"
         crit = g.is_critical
@@ -807,6 +815,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
             dist = float(np.linalg.norm(nail - prev_point)) if nail is not None else 0.0
             prev_point = nail
         if g.has_orientation:
+            q: Any
             if g.relative_rotation is not None:
                 angle = float(np.linalg.norm(g.relative_rotation))
                 q = quat.mul(quat.exp_normalized(g.relative_rotation), prev_q)
@@ -927,7 +936,7 @@ def resolve_scenario(
     for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
         times = _body_goal_times(b, s, s.control_frequency, s.time_grid, p)
-        goals = []
+        goals: list[Goal] = []
         for g, t in zip(b.goals, times, strict=True):
             nail = g.nail
             if g.nail_prop is not None:

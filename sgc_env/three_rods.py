@@ -15,12 +15,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
-from scipy.interpolate import make_interp_spline
-from scipy.spatial.transform import Rotation
+
+if TYPE_CHECKING:  # scipy is imported where a scene is built: constants stay cheap to import
+    from scipy.spatial.transform import Rotation
 
 __all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
 
@@ -120,6 +121,8 @@ def _spline(points: np.ndarray):
     """Cubic spline through ``points`` parametrised by cumulative chord length."""
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
     knots = np.concatenate(([0.0], np.cumsum(chord)))
+    from scipy.interpolate import make_interp_spline
+
     return make_interp_spline(knots, points, k=3), knots
 
 
@@ -136,6 +139,8 @@ def _arc_length_samples(spline, s0: float, s1: float, count: int) -> np.ndarray:
 
 def _align(previous: Rotation, tangent: np.ndarray) -> Rotation:
     """``previous`` turned by the smallest rotation that points its z axis along ``tangent``."""
+    from scipy.spatial.transform import Rotation
+
     axis_now = previous.apply([0.0, 0.0, 1.0])
     t = tangent / np.linalg.norm(tangent)
     cross = np.cross(axis_now, t)
@@ -164,6 +169,8 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
             _arc_length_samples(spline, knots[spec.ball_index], knots[-1], spec.samples_after),
         )
     )
+    from scipy.spatial.transform import Rotation
+
     start = Rotation.identity()
     start = _align(_align(start, np.array([1.0, 0.0, 0.0])), tangent(knots[0]))
     tip_start = points[0]

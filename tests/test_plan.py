@@ -101,7 +101,7 @@ def test_end_velocity_between_averages_within_paper_assumption():
         nails = np.cumsum(rng.normal(size=(6, 3)) * 0.1 + np.array([1.0, 0.3, 0.0]), axis=0)
         times = np.cumsum(rng.uniform(0.4, 1.2, 6))
         goals = [PositionGoal(t, n) for t, n in zip(times, nails, strict=True)]
-        plan = plan_body(_state(), goals)
+        plan = plan_body(_state(), goals, options=PlanOptions(end_rule="paper"))
         starts = [np.array([0, 0, 1.0]) - nails[0]] + [nails[i] - nails[i + 1] for i in range(5)]
         durations = np.diff(np.concatenate(([0.0], times)))
         for c in plan.courses:

@@ -20,6 +20,13 @@ from sgc_env.scenario import LIMITS, Body, Goal, Prop, Scenario, resolve_scenari
 from sgc_env.simulator import connected_clients
 
 
+@pytest.fixture(autouse=True)
+def close_envs():
+    """Replaces conftest's fixture of that name in this module: it keeps every env alive to
+    close it after the test, and these tests are about envs nobody closes or keeps."""
+    yield []
+
+
 def rollout(env: SGCEnv, seed: int, steps: int = 40) -> list[bytes]:
     """Observations and rewards of a seeded random rollout, as bytes."""
     obs, _ = env.reset(seed=seed)

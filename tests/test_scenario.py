@@ -178,6 +178,8 @@ BAD_INPUTS = [
      "bodies[0].force_limit: 5.0 N cannot hold the body against gravity"),
     ("bad time grid", lambda d: d.update(time_grid="round"),
      "time_grid: expected one of ('reject', 'snap')"),
+    ("bad end rule", lambda d: d.update(end_velocity_rule="spline"),
+     "end_velocity_rule: expected one of ('tangent', 'paper'), got 'spline'"),
     ("no bodies", lambda d: d.update(bodies=[]),
      "bodies: expected a non-empty list of bodies"),
 ]  # fmt: skip

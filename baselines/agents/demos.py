@@ -1,8 +1,8 @@
 """Expert demonstrations: seeded rollouts stored in one ``.npz`` file.
 
-Minari was checked and left out: its 0.5 recorder needs jax (``minari[create]``) and its HDF5
-storage needs an undeclared Pillow, which is a lot of weight for a table of arrays. The format
-here is flat and documented (docs/agents.md):
+This flat npz is what behaviour cloning and DAgger read; a Minari dataset of the same
+episodes is :mod:`baselines.agents.minari_data` (``sgc demos --format minari``). The format
+(docs/agents.md):
 
 | key | shape | meaning |
 |---|---|---|

@@ -16,18 +16,16 @@ from typing import Any
 
 import yaml
 
+from baselines.shipped import hyperparams_file
+
 __all__ = [
     "ALGORITHMS",
-    "DEFAULT_HYPERPARAMS_DIR",
     "Hyperparams",
     "algorithm_class",
     "linear_schedule",
     "load_hyperparams",
     "parse_kwargs_string",
 ]
-
-DEFAULT_HYPERPARAMS_DIR = Path(__file__).resolve().parents[2] / "hyperparams"
-"""``hyperparams/`` at the repository top (the package is installed editable)."""
 
 _ACTIVATIONS = ("ReLU", "Tanh", "ELU", "LeakyReLU", "SiLU", "GELU", "Sigmoid")
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
@@ -153,9 +151,9 @@ def algorithm_class(algo: str):
 
 
 def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
-    """Read ``<directory>/<algo>.yml`` and resolve the entry for ``env_id``."""
+    """Read ``<directory>/<algo>.yml`` (default: the packaged file) and resolve ``env_id``."""
     algo_cls = algorithm_class(algo)
-    path = Path(directory or DEFAULT_HYPERPARAMS_DIR) / f"{algo}.yml"
+    path = Path(directory) / f"{algo}.yml" if directory else hyperparams_file(algo)
     if not path.is_file():
         raise ValueError(f"algo: no hyperparameter file {path}")
     try:

@@ -134,7 +134,7 @@ def _jsonable(value: Any) -> Any:
 def train(cfg: TrainConfig) -> TrainResult:
     """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
     import torch as th
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -170,7 +170,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     bc_info = None
     if cfg.init == "bc":
         bc_info = _clone(model, cfg)
-    callbacks = []
+    callbacks: list[BaseCallback] = []
     if cfg.critic_warmup:
         callbacks.append(FreezeActorCallback(cfg.critic_warmup))
     if out is not None and cfg.checkpoint_freq:

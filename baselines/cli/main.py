@@ -12,6 +12,7 @@ import sys
 from collections.abc import Sequence
 
 from baselines.cli.checks import UsageError
+from baselines.cli.console import DefaultsHelpFormatter
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -32,7 +33,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_text in COMMANDS.items():
         module = importlib.import_module(f"baselines.cli.commands.{name.replace('-', '_')}")
-        command_parser = sub.add_parser(name, help=help_text, description=help_text)
+        command_parser = sub.add_parser(
+            name, help=help_text, description=help_text, formatter_class=DefaultsHelpFormatter
+        )
         module.add_arguments(command_parser)
         command_parser.set_defaults(_module=module)
     return parser

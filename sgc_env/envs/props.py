@@ -22,9 +22,9 @@ class PropPaths:
         self._frequency = sim_frequency
         self.last = last
         self._start = -1
-        self._chunk: list[list[tuple[float, float, float]]] = []
+        self._chunk: list[list[tuple[float, ...]]] = []
 
-    def at(self, j: int) -> list[tuple[float, float, float]]:
+    def at(self, j: int) -> list[tuple[float, ...]]:
         """One ``(x, y, z)`` per prop at substep ``min(j, last)``."""
         j = min(j, self.last)
         if not self._start <= j < self._start + len(self._chunk):

@@ -8,19 +8,21 @@ are met *exactly* and *punctually* only by planning; nothing in the env snaps bo
 
 ## Action space
 
-``Box(-1, 1, (6 * n_bodies,))``: per body force xyz in the world frame, scaled by the body's
-``force_limit`` (N), then torque about the body's principal axes, scaled per axis by
-``torque_scale = torque_limit * I / max(I)`` (N m; ``env.torque_scale``, one row per body), so
-that an action of 1 gives the same angular acceleration ``torque_limit / max(I)`` about every
-axis. The world torque is ``R0 (torque_scale * a)`` with ``R0`` the body's orientation at the
-start of the control step. Why body axes: a thin rod's axial inertia is ~70 times smaller than
-its transverse one, so a world-frame torque box made its roll hypersensitive (an action error of
-1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its axis) and no learned policy met a rod
-orientation goal; scaled body axes make every axis equally sensitive. When every body is a
-sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``. The force acts at
-the centre of mass; gravity is *not* compensated. The action is held for one control period
-(``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default) and re-applied on
-every substep (the world torque too: it is fixed at the step's start).
+``Box(-1, 1, (6 * n_bodies,))``: per body force xyz then torque xyz, both in the world frame.
+The force is scaled by the body's ``force_limit`` (N). The torque is scaled per principal axis,
+``tau = R0 diag(torque_scale) R0^T a`` with ``torque_scale = torque_limit * I / max(I)`` (N m;
+``env.torque_scale``, one row per body) and ``R0`` the body's orientation at the start of the
+control step: a torque action is an angular-acceleration command, and an action of 1 along
+any direction gives the same angular acceleration ``torque_limit / max(I)`` (gyroscopic terms
+aside). Why: a thin rod's axial inertia is ~70 times smaller than its transverse one, so with a
+plain world-frame torque box an action error of 1e-3 spun a 0.6 m rod at 6.7 rad/s^2 about its
+axis and no learned policy met a rod orientation goal. Why world axes rather than body axes:
+body-axis actions make the policy rotate its world-frame observation (phi, omega) into the
+body frame, and a clone trained on them spun the rod up (1/150 goals, docs/agents.md). When
+every body is a sphere without orientation goals the torque is dropped: ``(3 * n_bodies,)``.
+The force acts at the centre of mass; gravity is *not* compensated. The action is held for one
+control period (``sim_frequency / control_frequency`` PyBullet steps, 240 / 60 = 4 by default)
+and re-applied on every substep (the torque too: it is fixed at the step's start).
 
 ## Observation space
 
@@ -110,13 +112,14 @@ import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.paper.quaternion import rotate
+from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
@@ -171,6 +174,7 @@ class StepInfo(_StepInfoEveryStep, total=False):
     one row per body; ``goal_reached`` only on a tick where goals fall."""
 
     goal_reached: list[GoalEvent]
+    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
 
 
 @dataclass(frozen=True)
@@ -244,7 +248,7 @@ class SGCEnv(gym.Env):
         camera: dict[str, Any] | None = None,
         reward: str = "schedule",
     ) -> None:
-        self._init_kwargs = {
+        self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
@@ -262,7 +266,11 @@ class SGCEnv(gym.Env):
         self.camera = CameraConfig.from_dict(camera)
         self._random_config: SceneFamily | None = None
         if scenario is None:
-            cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
+            cfg = (
+                PRESETS[random_scenario]
+                if isinstance(random_scenario, str)
+                else cast(SceneFamily, random_scenario)  # not None: checked above
+            )
             if control_frequency is not None:
                 cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
@@ -370,10 +378,7 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
+        max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
         return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
 
@@ -410,7 +415,7 @@ class SGCEnv(gym.Env):
 
     # ---------------------------------------------------------------- reset / step
 
-    def reset(
+    def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, StepInfo]:
         self._check_open()
@@ -501,7 +506,9 @@ class SGCEnv(gym.Env):
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
+    def step(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
+        self, action: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         if self._closed:
             self._check_open()
         a = action if type(action) is np.ndarray else np.asarray(action)
@@ -534,7 +541,8 @@ class SGCEnv(gym.Env):
             tq = None
             if use_torque:
                 sx, sy, sz = self._tscale[i]
-                tq = rotate(orn, (values[o + 3] * sx, values[o + 4] * sy, values[o + 5] * sz))
+                bx, by, bz = rotate_back(orn, (values[o + 3], values[o + 4], values[o + 5]))
+                tq = rotate(orn, (bx * sx, by * sy, bz * sz))
                 applied_t += tq
             m = self._mass[i]
             ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
@@ -546,7 +554,7 @@ class SGCEnv(gym.Env):
                 for kh, c in coef
             ]
             drives.append((self._uids[i], f, tq, path))
-        moves: list[list[tuple[int, tuple[float, float, float]]]] = []
+        moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
             at = self._props.at
@@ -703,6 +711,7 @@ class SGCEnv(gym.Env):
         sim = getattr(self, "sim", None)
         if sim is not None:
             sim.close()
+            self.sim = None  # type: ignore[assignment]
         self._closed = True
         super().close()
 

@@ -239,7 +239,7 @@ class GoalTask:
         )
         pscale, oscale = self.position_scale, self.orientation_scale
         points = []
-        deviations = []
+        deviations: list[tuple[float, ...]] = []
         ptls = []
         otls = []
         cost = 0.0

@@ -28,11 +28,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 Num = float | np.ndarray
+Floats3 = tuple[float, float, float]
+Arrays3 = tuple[np.ndarray, np.ndarray, np.ndarray]
 """A float or an array of them (the profiles evaluate either elementwise)."""
 
 __all__ = [
@@ -297,7 +300,7 @@ class CourseProfile:
             d, v, a = _osc_profile(self._m, self._s, self._p, tau, u)
         else:
             d, v, a = _over_profile(self._m, self._w, tau, u)
-        return self.d0 * d, self.d0 * v / T, self.d0 * a / (T * T)
+        return cast(Arrays3, (self.d0 * d, self.d0 * v / T, self.d0 * a / (T * T)))
 
     def position(self, t: float | np.ndarray) -> float | np.ndarray:
         """``D(t)``."""
@@ -576,11 +579,11 @@ class HermiteProfile:
 
     def state(self, t: float) -> tuple[float, float, float]:
         """``(D, D', D'')`` at scalar ``t`` (plain floats: the expert's per-step path)."""
-        return self._cubic(float(t) / self.duration)
+        return cast(Floats3, self._cubic(float(t) / self.duration))
 
     def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(D, D', D'')`` at ``t`` seconds from the course start."""
-        return self._cubic(np.asarray(t, dtype=float) / self.duration)
+        return cast(Arrays3, self._cubic(np.asarray(t, dtype=float) / self.duration))
 
     def _cubic(self, s: Num) -> tuple[Num, Num, Num]:
         """The cubic and its derivatives at normalised time ``s`` (a float or an array)."""

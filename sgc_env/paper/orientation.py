@@ -66,7 +66,7 @@ def course_pieces(rotation_vector: ArrayLike) -> int:
 
 
 def split_rotation(
-    rotation_vector: Sequence[float],
+    rotation_vector: Sequence[float] | np.ndarray,
     t0: float,
     t1: float,
     control_frequency: int | None = None,
@@ -161,7 +161,7 @@ def _inverse_coefficient(theta: float) -> float:
 
 
 def left_jacobian_inverse_apply(
-    phi: Sequence[float], omega: Sequence[float]
+    phi: Sequence[float] | np.ndarray, omega: Sequence[float] | np.ndarray
 ) -> tuple[float, float, float]:
     """``phi_dot`` with ``J_l(phi) phi_dot = omega``, in plain floats (the expert's per-step
     path: ``omega - phi x omega / 2 + e phi x (phi x omega)``, no 3x3 matrix).

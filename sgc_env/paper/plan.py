@@ -28,11 +28,13 @@ import bisect
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
 from sgc_env.paper.frames import (
     C_HIGH,
     C_LOW,
@@ -111,12 +113,14 @@ class OrientationGoal:
 
 @dataclass(frozen=True)
 class PlanOptions:
-    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there) and the
-    control grid split somersaults are timed on."""
+    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there), the
+    end-velocity rule of interior goals (``"tangent"``, the default, or ``"paper"``: eqs.
+    12-14) and the control grid split somersaults are timed on."""
 
     c_low: float = C_LOW
     c_high: float = C_HIGH
     k_min: float = K_MIN
+    end_rule: str = DEFAULT_END_RULE
     control_frequency: int | None = None
     """Time a split somersault's sub-courses on this control grid, as the env does (None:
     evenly in continuous time)."""
@@ -132,6 +136,10 @@ class PlanOptions:
             raise ValueError(f"options: c_high must be in (0, 1) (eq. 13), got {self.c_high!r}")
         if not 0.0 < self.k_min <= 1.0:
             raise ValueError(f"options: k_min must be in (0, 1], got {self.k_min!r}")
+        if self.end_rule not in END_RULES:
+            raise ValueError(
+                f"options: end_rule must be one of {list(END_RULES)}, got {self.end_rule!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -144,7 +152,7 @@ class CourseDiagnostics:
     index: int
     t_start: float
     t_end: float
-    branches: tuple[str, str, str]
+    branches: tuple[str, ...]
     k: np.ndarray
     turn_angle: float
     within_paper_assumption: bool
@@ -322,7 +330,7 @@ def _orientation_courses(
         if (g.orientation is None) == (g.relative_rotation is None):
             raise ValueError(f"{where}: give exactly one of orientation and relative_rotation")
         if g.relative_rotation is None:
-            goal = _quat(g.orientation, where, "orientation")
+            goal = _quat(cast(np.ndarray, g.orientation), where, "orientation")  # checked above
             out.append((goal, (prev * goal.inv()).as_rotvec(), times[i], i))
             prev = goal
         else:
@@ -347,7 +355,9 @@ def _plan_orientation(
     pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
-    courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
+    courses: list[Any] = []
+    t_prev = 0.0
+    phi_dot: np.ndarray = np.array(left_jacobian_inverse_apply(starts[0], w0))
     for i, phi0 in enumerate(starts):
         T = ends[i] - t_prev
         last = i == len(starts) - 1
@@ -355,7 +365,7 @@ def _plan_orientation(
         v_end, info = course_end_velocity(
             phi0, nxt, T, None if last else ends[i + 1] - ends[i],
             end_velocity=end_w if last else None,
-            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min,
+            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min, rule=opts.end_rule,
         )  # fmt: skip
         course = _solve_in_frame(info.frame, phi0, phi_dot, T, v_end)
         courses.append(course)
@@ -424,6 +434,7 @@ def _plan_position(
             c_low=opts.c_low,
             c_high=opts.c_high,
             k_min=opts.k_min,
+            rule=opts.end_rule,
         )
         course = _solve_in_frame(info.frame, d0, dv0, T, v_end)
         courses.append(course)
@@ -470,7 +481,9 @@ def plan_body(
     p_times = _check_times([g.time for g in position_goals], "position")
     o_times = _check_times([g.time for g in orientation_goals], "orientation")
     diags: list[CourseDiagnostics] = []
-    rots, goal_rots, o_track = [], [], None
+    rots: list[Rotation] = []
+    goal_rots: list[Rotation] = []
+    o_track = None
     if orientation_goals:
         rots, goal_rots, o_track = _plan_orientation(
             r0, w0, orientation_goals, o_times, end_w, opts, diags

@@ -126,6 +126,11 @@ def rotate(q: Sequence[float], v: Sequence[float]) -> Vec3:
     )
 
 
+def rotate_back(q: Sequence[float], v: Sequence[float]) -> Vec3:
+    """``R(q)^T v``: ``v`` from the world into the frame of a unit quaternion ``q``."""
+    return rotate((-q[0], -q[1], -q[2], q[3]), v)
+
+
 def to_matrix(q: Sequence[float]) -> tuple[Vec3, Vec3, Vec3]:
     """Rotation matrix of ``q`` as three row tuples."""
     x, y, z, w = q
