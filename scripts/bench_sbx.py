@@ -8,7 +8,7 @@ Needs a venv with both (SBX is not a project dependency)::
     PYTHONPATH=$PWD /work/scratch-sbx/bin/python scripts/bench_sbx.py [--ppo-steps 8192]
 
 Each library trains PPO and SAC on SGCPoint-v0 with the hyperparameters of
-hyperparams/{ppo,sac}.yml (256-256 networks; PPO 4 envs x 512 steps, 10 epochs, batch 256;
+baselines/hyperparams/{ppo,sac}.yml (256-256 networks; PPO 4 envs x 512 steps, 10 epochs, batch 256;
 SAC one gradient step of batch 256 per env step, from step 100). Every measurement follows
 a short warm-up run of the same model (JIT compilation, allocator), and the libraries
 alternate (``--repeats``), so both see the same machine load. Printed: env steps per second
