@@ -8,12 +8,11 @@ dynamic-constraints and the minimum-jerk baselines differ only in how they choos
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from baselines.env_model import BodyModel, EnvModel
+from baselines.observation_fields import BodyObservation
 from baselines.tracking import (
     held_acceleration_for_position,
     simulate_rotation,
@@ -21,67 +20,10 @@ from baselines.tracking import (
 )
 from sgc_env.paper import quaternion as quat
 
-__all__ = ["BodyObservation", "body_wrench", "read_body", "wrench_for_targets"]
+__all__ = ["body_wrench", "wrench_for_targets"]
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
-
-_TRACKS = ("position", "orientation")
-_TRACK_FIELDS = (
-    "deviation", "time_left", "course_start", "course_duration", "next_start",
-    "next_duration", "end_velocity", "flags",
-)  # fmt: skip
-
-
-@dataclass(frozen=True)
-class BodyObservation:
-    """One body's observation block in double precision (float32 value + residual)."""
-
-    orientation: np.ndarray
-    angular_velocity: np.ndarray
-    linear_velocity: np.ndarray
-    point_offset: np.ndarray
-    point_velocity: np.ndarray
-    position: dict[str, np.ndarray]
-    orientation_track: dict[str, np.ndarray]
-
-    def track(self, name: str) -> dict[str, np.ndarray]:
-        return self.position if name == "position" else self.orientation_track
-
-    def has_goal_ahead(self, name: str, period: float) -> bool:
-        """True while a goal of track ``name`` lies at least one tick ahead.
-
-        Half a period of slack: on a goal's own tick the time left is zero up to rounding of
-        the tick times, and that goal must count as reached, not as still ahead.
-        """
-        t = self.track(name)
-        return bool(t["flags"][0] > 0.5 and t["time_left"][0] > 0.5 * period)
-
-
-def read_body(model: EnvModel, observation: np.ndarray, body: int) -> BodyObservation:
-    """Extract body ``body``'s fields, adding each ``<field>_residual`` where the layout has one."""
-    layout = model.layout
-    obs = np.asarray(observation, dtype=np.float64)
-
-    def field(name: str) -> np.ndarray:
-        value = obs[layout.body_slice(body, name)]
-        if layout.has_body_field(f"{name}_residual"):
-            value = value + obs[layout.body_slice(body, f"{name}_residual")]
-        return value
-
-    q = field("orientation")
-    tracks = {
-        track: {name: field(f"{track}_{name}") for name in _TRACK_FIELDS} for track in _TRACKS
-    }
-    return BodyObservation(
-        orientation=q / np.linalg.norm(q),
-        angular_velocity=field("angular_velocity"),
-        linear_velocity=field("linear_velocity"),
-        point_offset=field("point_offset"),
-        point_velocity=field("point_velocity"),
-        position=tracks["position"],
-        orientation_track=tracks["orientation"],
-    )
 
 
 def wrench_for_targets(
@@ -151,7 +93,7 @@ def body_wrench(
     vx, vy, vz = linear_velocity
     accel = held_acceleration_for_position  # per component: plain floats, no arrays
     return (
-        mass * (accel(0.0, vx, dx - (ax - bx), h, n) - gx),
-        mass * (accel(0.0, vy, dy - (ay - by), h, n) - gy),
-        mass * (accel(0.0, vz, dz - (az - bz), h, n) - gz),
+        mass * (float(accel(0.0, vx, dx - (ax - bx), h, n)) - gx),
+        mass * (float(accel(0.0, vy, dy - (ay - by), h, n)) - gy),
+        mass * (float(accel(0.0, vz, dz - (az - bz), h, n)) - gz),
     ), torque

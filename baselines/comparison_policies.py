@@ -18,18 +18,20 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.actuation import BodyObservation, read_body, wrench_for_targets
+from baselines.actuation import wrench_for_targets
 from baselines.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.env_model import EnvModel
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.observation_fields import BodyObservation, read_body
+from baselines.vector import base_env, sub_env
 from sgc_env.metrics import goals_from_scenario
 from sgc_env.paper.orientation import left_jacobian_inverse
+from sgc_env.paper.quaternion import unwrap_rotvec
 from sgc_env.scenario import Scenario
 
 __all__ = [
@@ -46,36 +48,6 @@ __all__ = [
 _TRACKS = ("position", "orientation")
 
 
-_MODEL_ATTRIBUTES = (
-    "scenario",
-    "body_inertia",
-    "torque_scale",
-    "layout",
-    "sim_frequency",
-    "substeps",
-    "use_torque",
-)
-
-
-def sub_env(env: Any, index: int) -> Any:
-    """Sub-env ``index`` of a vector env (SB3 or gymnasium), or ``env`` itself.
-
-    Envs behind processes are represented by a stand-in carrying the attributes that
-    :meth:`EnvModel.from_env` and the scenario look-ups need.
-    """
-    if hasattr(env, "envs"):
-        return env.envs[index]
-    if hasattr(env, "get_attr"):
-        values = {}
-        for name in _MODEL_ATTRIBUTES:
-            try:
-                values[name] = env.get_attr(name, [index])[0]
-            except TypeError:
-                values[name] = env.get_attr(name)[index]
-        return SimpleNamespace(unwrapped=SimpleNamespace(**values))
-    return env
-
-
 def episode_model(env: Any, index: int = 0) -> EnvModel:
     """The :class:`EnvModel` of sub-env ``index`` *now*.
 
@@ -87,7 +59,7 @@ def episode_model(env: Any, index: int = 0) -> EnvModel:
 
 def scenario_of(env: Any, index: int = 0) -> Scenario:
     """The resolved scenario of sub-env ``index`` (plain, wrapped or vector env)."""
-    return sub_env(env, index).unwrapped.scenario
+    return base_env(env, index).scenario
 
 
 def observation_tick(model: EnvModel, observation: np.ndarray) -> int:
@@ -221,13 +193,7 @@ def _compose(phi: np.ndarray, start: np.ndarray) -> np.ndarray:
     goals, as the observation gives it), R = Exp(phi') R_j.
     """
     principal = (Rotation.from_rotvec(phi) * Rotation.from_rotvec(start)).as_rotvec()
-    reference = phi + start
-    angle = float(np.linalg.norm(principal))
-    if angle < 1e-12:
-        return principal
-    axis = principal / angle
-    turns = round((axis @ reference - angle) / (2.0 * np.pi))
-    return axis * (angle + 2.0 * np.pi * turns)
+    return np.array(unwrap_rotvec(principal, phi + start))
 
 
 class DynamicConstraintsController(_StatefulPolicy):

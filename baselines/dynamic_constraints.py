@@ -123,8 +123,8 @@ class DynamicConstraintsCourse:
             return 0.0
         c, d0, tau = self._c, self.d0, self.tau
         qa, qb, qc = c @ c, 2.0 * (d0 @ c), d0 @ d0
-        crit = np.roots([-2.0 * qa / tau, 2.0 * qa - 2.0 * qb / tau, qb - 2.0 * qc / tau])
-        crit = sorted(float(r.real) for r in np.atleast_1d(crit) if abs(r.imag) < 1e-12)
+        roots = np.roots([-2.0 * qa / tau, 2.0 * qa - 2.0 * qb / tau, qb - 2.0 * qc / tau])
+        crit = sorted(float(r.real) for r in np.atleast_1d(roots) if abs(r.imag) < 1e-12)
         t_hi = tau
         bound = float(np.linalg.norm(d0))
         speed = float(np.linalg.norm(c))
@@ -182,7 +182,11 @@ def simulate(
     nails = [_vector(p, f"targets[{i}]") for i, p in enumerate(targets)]
     if any(n.shape != x.shape for n in nails):
         raise ValueError("every target must have the shape of start")
-    tau_list = [float(taus)] * len(nails) if np.isscalar(taus) else list(taus)
+    tau_list = (
+        [float(taus)] * len(nails)
+        if isinstance(taus, (int, float, np.number))
+        else [float(t) for t in taus]
+    )
     if len(tau_list) != len(nails):
         raise ValueError(f"taus has {len(tau_list)} entries for {len(nails)} targets")
     for i, tau in enumerate(tau_list):
@@ -212,7 +216,7 @@ def simulate(
             goal += 1
     accelerations[n_steps] = accelerations[n_steps - 1] if n_steps else 0.0
     return DynamicConstraintsRollout(
-        times=np.arange(n_steps + 1) * h,
+        times=np.arange(n_steps + 1, dtype=float) * h,
         positions=positions,
         velocities=velocities,
         accelerations=accelerations,

@@ -12,8 +12,10 @@ from typing import Any
 
 import numpy as np
 
+from baselines.vector import base_env
 from sgc_env.observation import ObservationLayout
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE
 
 __all__ = ["BodyModel", "EnvModel"]
 
@@ -40,6 +42,8 @@ class EnvModel:
     sim_dt: float
     substeps: int
     use_torque: bool
+    end_rule: str = DEFAULT_END_RULE
+    """The scenario's ``end_velocity_rule``: how a planner ends an interior course."""
 
     @property
     def control_dt(self) -> float:
@@ -48,7 +52,7 @@ class EnvModel:
     @classmethod
     def from_env(cls, env: Any) -> EnvModel:
         """Read the model of a Gymnasium env (wrapped or not) or of a vector env's first env."""
-        base = _unwrap(env)
+        base = base_env(env)
         scenario = base.scenario
         bodies = tuple(
             BodyModel(
@@ -69,6 +73,7 @@ class EnvModel:
             sim_dt=1.0 / float(base.sim_frequency),
             substeps=int(base.substeps),
             use_torque=bool(base.use_torque),
+            end_rule=scenario.end_velocity_rule,
         )
 
     def action_from_wrenches(self, forces, torques, orientations) -> np.ndarray:
@@ -101,14 +106,3 @@ class EnvModel:
                 out += quat.rotate(q, (bx / sx, by / sy, bz / sz))
         return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
 
-
-def _unwrap(env: Any) -> Any:
-    """The base SGC env behind wrappers, or behind the first sub-env of a vector env."""
-    if hasattr(env, "get_attr") and not hasattr(env, "unwrapped"):
-        return env.get_attr("unwrapped", [0])[0]
-    if hasattr(env, "envs"):
-        return env.envs[0].unwrapped
-    base = env.unwrapped
-    if not hasattr(base, "scenario"):
-        raise TypeError(f"{type(base).__name__} is not an SGC environment (no scenario)")
-    return base

@@ -17,18 +17,20 @@ import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
 
 import sgc_env
-from baselines.policies import make_policy, policy_label
+from baselines.policies import Policy, make_policy, policy_label
 from sgc_env.metrics import GoalSpec, Tolerances, goals_from_scenario, score_episode
 
 __all__ = [
     "GOAL_COLUMNS",
     "SUMMARY_KEYS",
+    "GoalRow",
+    "Scorecard",
     "EpisodeRecord",
     "EvaluationResult",
     "evaluate",
@@ -40,29 +42,80 @@ __all__ = [
     "write_summary_json",
 ]
 
-GOAL_COLUMNS: tuple[str, ...] = (
-    "env_id", "policy", "episode", "seed", "body", "goal", "time",
-    "position_error", "orientation_error", "closest_approach_offset", "entry_offset",
-    "position_closest_offset", "orientation_closest_offset", "position_entry_offset",
-    "orientation_entry_offset", "closest_distance", "closest_angle", "speed",
-    "goal_speed_ratio", "velocity_jump", "angular_velocity_jump", "success",
-)  # fmt: skip
 
-#: Keys of the summary scorecard, grouped as in docs/evaluation.md.
-SUMMARY_KEYS: tuple[str, ...] = (
-    "env_id", "policy", "episodes", "seed", "steps", "wall_time_s", "return_mean",
-    "terminated", "n_goals", "goals_met", "goals_after_end", "success_rate",
-    "position_error_max", "position_error_mean", "orientation_error_max",
-    "orientation_error_mean",
-    "position_closest_offset_abs_max", "orientation_closest_offset_abs_max",
-    "position_entry_offset_abs_max", "orientation_entry_offset_abs_max",
-    "sparc_mean", "sparc_track_mean", "ldlj_mean", "angular_sparc_mean", "velocity_jump_max",
-    "angular_velocity_jump_max", "speed_minima_mean", "goal_speed_ratio_min",
-    "rotation_ratio_max", "rotation_excess_mean",
-    "force_sq_integral_mean", "torque_sq_integral_mean", "force_peak_max", "torque_peak_max",
-)  # fmt: skip
+class GoalRow(TypedDict):
+    """One goal of one episode in the per-goal table (``goals.csv``); None where n/a."""
 
-PolicyLike = Any
+    env_id: str
+    policy: str
+    episode: int
+    seed: int
+    body: int
+    goal: int
+    time: float
+    position_error: float | None
+    orientation_error: float | None
+    closest_approach_offset: float
+    entry_offset: float
+    position_closest_offset: float | None
+    orientation_closest_offset: float | None
+    position_entry_offset: float | None
+    orientation_entry_offset: float | None
+    closest_distance: float | None
+    closest_angle: float | None
+    speed: float | None
+    goal_speed_ratio: float | None
+    velocity_jump: float | None
+    angular_velocity_jump: float | None
+    success: bool
+
+
+class Scorecard(TypedDict):
+    """The summary of one policy on one env, grouped as in docs/evaluation.md."""
+
+    env_id: str
+    policy: str
+    episodes: int
+    seed: int
+    steps: int
+    wall_time_s: float
+    return_mean: float
+    terminated: int
+    n_goals: int
+    goals_met: int
+    goals_after_end: int
+    success_rate: float
+    position_error_max: float
+    position_error_mean: float
+    orientation_error_max: float
+    orientation_error_mean: float
+    position_closest_offset_abs_max: float
+    orientation_closest_offset_abs_max: float
+    position_entry_offset_abs_max: float
+    orientation_entry_offset_abs_max: float
+    sparc_mean: float
+    sparc_track_mean: float
+    ldlj_mean: float
+    angular_sparc_mean: float
+    velocity_jump_max: float
+    angular_velocity_jump_max: float
+    speed_minima_mean: float
+    goal_speed_ratio_min: float
+    rotation_ratio_max: float
+    rotation_excess_mean: float
+    force_sq_integral_mean: float
+    torque_sq_integral_mean: float
+    force_peak_max: float
+    torque_peak_max: float
+
+
+GOAL_COLUMNS: tuple[str, ...] = tuple(GoalRow.__annotations__)
+"""Columns of ``goals.csv``, in order: the keys of :class:`GoalRow`."""
+
+SUMMARY_KEYS: tuple[str, ...] = tuple(Scorecard.__annotations__)
+"""Keys of the summary scorecard, in order: the keys of :class:`Scorecard`."""
+
+PolicyLike = Policy
 
 
 @dataclass
@@ -90,8 +143,8 @@ class EvaluationResult:
     policy: str
     seed: int
     episodes: list[EpisodeRecord]
-    rows: list[dict[str, Any]] = field(default_factory=list)
-    summary: dict[str, Any] = field(default_factory=dict)
+    rows: list[GoalRow] = field(default_factory=list)
+    summary: Scorecard = field(default_factory=dict)  # type: ignore[assignment]
 
 
 def _finite(values: Iterable[Any]) -> np.ndarray:
@@ -130,7 +183,7 @@ def run_episode(
     tolerances: Tolerances | None = None,
     keep_infos: bool = False,
     max_steps: int = 100_000,
-    frames: list[np.ndarray] | None = None,
+    frames: list[Any] | None = None,
     on_step: Callable[[gym.Env, int, Mapping[str, Any]], None] | None = None,
 ) -> EpisodeRecord:
     """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
@@ -162,7 +215,7 @@ def run_episode(
             on_step(env, len(infos), info)
         if terminated or truncated:
             break
-    base = env.unwrapped
+    base: Any = env.unwrapped
     goals = goals_from_scenario(base.scenario)
     card = score_episode(infos, goals, base.dt, tolerances, initial_info=initial_info)
     return EpisodeRecord(
@@ -180,14 +233,14 @@ def run_episode(
     )
 
 
-def goal_rows(record: EpisodeRecord, env_id: str, policy: str) -> list[dict[str, Any]]:
+def goal_rows(record: EpisodeRecord, env_id: str, policy: str) -> list[GoalRow]:
     """One row per goal of every body (columns :data:`GOAL_COLUMNS`; None where n/a).
 
     A goal with a nail and an orientation is one row; ``closest_approach_offset`` and
     ``entry_offset`` (s, signed, positive = late) are the position track's where the goal
     has a nail, else the orientation track's.
     """
-    rows = []
+    rows: list[GoalRow] = []
     for b, (body_goals, card) in enumerate(zip(record.goals, record.card["bodies"], strict=True)):
         if card is None:
             continue
@@ -282,27 +335,20 @@ def summarize(
     }
 
 
-def _check_env_id(env_id: str) -> None:
-    if not isinstance(env_id, str) or env_id not in gym.registry:
-        raise ValueError(
-            f"env_id: unknown environment {env_id!r}; SGC ids: {list(sgc_env.ENV_IDS)}"
-        )
-
-
 def _resolve_policy(
     policy: PolicyLike | str | Callable[[gym.Env], PolicyLike], env: gym.Env, seed: int
 ) -> tuple[PolicyLike, str]:
     if isinstance(policy, str):
         return make_policy(policy, env, seed=seed), policy_label(policy)
     if isinstance(policy, type) or (callable(policy) and not hasattr(policy, "predict")):
-        built = policy(env)
+        built = cast(Callable[[Any], Policy], policy)(env)
         return built, type(built).__name__
     if not hasattr(policy, "predict"):
         raise ValueError(
             f"policy must be a spec string, an object with .predict or a factory of one, "
             f"got {type(policy).__name__}"
         )
-    return policy, type(policy).__name__
+    return cast(PolicyLike, policy), type(policy).__name__
 
 
 def evaluate(
@@ -324,7 +370,7 @@ def evaluate(
     :class:`~baselines.MinimumJerkController`). ``keep_infos``: how many leading episodes
     keep their infos for plots. The env is created here and closed at the end.
     """
-    _check_env_id(env_id)
+    sgc_env.check_env_id(env_id)
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
@@ -349,7 +395,9 @@ def evaluate(
     finally:
         env.close()
     rows = [row for r in records for row in goal_rows(r, env_id, name)]
-    summary = {"env_id": env_id, "policy": name, "seed": int(seed), **summarize(records, rows)}
+    summary = cast(
+        Scorecard, {"env_id": env_id, "policy": name, "seed": int(seed), **summarize(records, rows)}
+    )
     return EvaluationResult(env_id, name, int(seed), records, rows, summary)
 
 

@@ -20,8 +20,9 @@ import numpy as np
 
 from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
-from sgc_env.observation import ObservationLayout
+from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import END_RULES
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
 
@@ -46,9 +47,17 @@ class SGCExpert:
     """
 
     def __init__(
-        self, env: Any | None = None, *, model: EnvModel | None = None, refine: bool = True
+        self,
+        env: Any | None = None,
+        *,
+        model: EnvModel | None = None,
+        refine: bool = True,
+        end_rule: str | None = None,
     ) -> None:
-        """``refine``: give the torque between goals its correction step on the simulated
+        """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
+        :mod:`sgc_env.paper.frames`); None follows the scenario (``model.end_rule``).
+
+        ``refine``: give the torque between goals its correction step on the simulated
         rotation (goal ticks always get the exact Newton).
 
         Measured on SGCRod-v0 and the three-rod demo: the closed-form first guess alone
@@ -63,10 +72,13 @@ class SGCExpert:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
             model = EnvModel.from_env(env)
+        if end_rule is not None and end_rule not in END_RULES:
+            raise ValueError(f"end_rule must be one of {list(END_RULES)}, got {end_rule!r}")
         self.model = model
         self.refine = refine
+        self.end_rule = end_rule
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
-        self._bodies: tuple[_BodyFields, ...] = ()
+        self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
         self._courses: dict[tuple[float, ...], tuple[tuple, tuple]] = {}
 
     def predict(
@@ -103,22 +115,25 @@ class SGCExpert:
             )
         if self._fields_of is not model:  # built lazily: ``model`` may be reassigned
             self._bodies = tuple(
-                _BodyFields(model.layout, i, body) for i, body in enumerate(model.bodies)
+                (BodyFields(model.layout, i), body) for i, body in enumerate(model.bodies)
             )
             self._fields_of = model
+            self._courses.clear()  # a new model may bring another end rule
         values = observation.tolist()
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError("observation contains non-finite values")
         forces, torques, rotations = [], [], []
-        for fields in self._bodies:
+        for fields, body in self._bodies:
             rotation = fields.rotation(values)
-            force, torque = self._body_wrench(fields, values, rotation)
+            force, torque = self._body_wrench(fields, body, values, rotation)
             forces.append(force)
             torques.append(torque)
             rotations.append(rotation)
         return model.action_from_wrenches(forces, torques, rotations)
 
-    def _body_wrench(self, f: _BodyFields, o: list[float], rotation: tuple) -> tuple[tuple, tuple]:
+    def _body_wrench(
+        self, f: BodyFields, body: BodyModel, o: list[float], rotation: tuple
+    ) -> tuple[tuple, tuple]:
         period = self.model.control_dt
         omega = f.vec(o, f.angular_velocity)
         # ``exact``: a goal is reached on the next tick, so the rotation must land exactly too
@@ -151,17 +166,17 @@ class SGCExpert:
                 deviation_next[2] - deviation[2],
             )
         return body_wrench(
-            self.model, f.body, rotation, omega, f.vec(o, f.linear_velocity),
+            self.model, body, rotation, omega, f.vec(o, f.linear_velocity),
             f.vec(o, f.point_offset), displacement, rotation_change,
             exact_rotation=exact, refine=self.refine,
         )  # fmt: skip
 
-    def _next_deviation(self, o, track: _TrackFields, deviation, rate, time_left, period):
+    def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
         """The re-solved rest of the current course, one control period ahead."""
-        key = tuple(o[track.course : track.course + _COURSE_SIZE])
+        key = tuple(o[track.course : track.course + COURSE_SIZE])
         course = self._courses.get(key)
         if course is None:
-            course = _course_constants(key)
+            course = _course_constants(key, self.end_rule or self.model.end_rule)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
@@ -169,14 +184,7 @@ class SGCExpert:
         return next_deviation(rows, deviation, rate, time_left, end_velocity, period)
 
 
-_COURSE_FIELDS = ("course_start", "course_duration", "next_start", "next_duration",
-                  "end_velocity", "flags")  # fmt: skip
-_COURSE_LAYOUT = [(0, 3), (3, 4), (4, 7), (7, 8), (8, 11), (11, 13)]
-_COURSE_SIZE = 13
-"""The course constants are contiguous in a body block: 3 + 1 + 3 + 1 + 3 + 2 entries."""
-
-
-def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
+def _course_constants(key: tuple[float, ...], rule: str) -> tuple[tuple, tuple]:
     """World end velocity and ``S_i`` rows of a course from its observation entries."""
     start, duration, nxt, next_duration, end_velocity = (
         key[0:3], key[3], key[4:7], key[7], key[8:11]
@@ -184,63 +192,7 @@ def _course_constants(key: tuple[float, ...]) -> tuple[tuple, tuple]:
     is_last = key[12] > 0.5
     velocity, info = course_end_velocity(
         start, None if is_last else nxt, duration, None if is_last else next_duration,
-        end_velocity=end_velocity if is_last else None,
+        end_velocity=end_velocity if is_last else None, rule=rule,
     )  # fmt: skip
     rows = _IDENTITY_ROWS if info.frame is None else tuple(map(tuple, info.frame.tolist()))
     return tuple(velocity.tolist()), rows
-
-
-class _TrackFields:
-    """Offsets of one track's entries in the flat observation."""
-
-    __slots__ = ("deviation", "time_left", "time_left_residual", "flags", "course")
-
-    def __init__(self, layout: ObservationLayout, body: int, name: str) -> None:
-        def at(field: str) -> int:
-            return layout.body_slice(body, f"{name}_{field}").start
-
-        self.deviation = (at("deviation"), at("deviation_residual"))
-        self.time_left, self.time_left_residual = at("time_left"), at("time_left_residual")
-        self.flags = at("flags")
-        self.course = at("course_start")
-        slices = [layout.body_slice(body, f"{name}_{x}") for x in _COURSE_FIELDS]
-        if [(sl.start - self.course, sl.stop - self.course) for sl in slices] != _COURSE_LAYOUT:
-            raise ValueError("the course constants are not where _course_constants reads them")
-
-
-class _BodyFields:
-    """Offsets of one body's entries (value, residual), computed once per expert."""
-
-    __slots__ = (
-        "body", "orientation", "angular_velocity", "linear_velocity", "point_offset",
-        "point_velocity", "position_track", "orientation_track",
-    )  # fmt: skip
-
-    def __init__(self, layout: ObservationLayout, index: int, body: BodyModel) -> None:
-        def at(field: str) -> tuple[int, int]:
-            return (
-                layout.body_slice(index, field).start,
-                layout.body_slice(index, f"{field}_residual").start,
-            )
-
-        self.body = body
-        self.orientation = at("orientation")
-        self.angular_velocity = at("angular_velocity")
-        self.linear_velocity = at("linear_velocity")
-        self.point_offset = at("point_offset")
-        self.point_velocity = at("point_velocity")
-        self.position_track = _TrackFields(layout, index, "position")
-        self.orientation_track = _TrackFields(layout, index, "orientation")
-
-    def rotation(self, o: list[float]) -> tuple[float, float, float, float]:
-        """The body's unit quaternion (xyzw) in double precision."""
-        a, r = self.orientation
-        x, y, z, w = o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2], o[a + 3] + o[r + 3]
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        return (x / norm, y / norm, z / norm, w / norm)
-
-    @staticmethod
-    def vec(o: list[float], at: tuple[int, int]) -> tuple[float, float, float]:
-        """Double-precision 3-vector: float32 entries plus their residuals."""
-        a, r = at
-        return (o[a] + o[r], o[a + 1] + o[r + 1], o[a + 2] + o[r + 2])

@@ -11,13 +11,16 @@ x0 + (x1 - x0)(10 s^3 - 15 s^4 + 6 s^5).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import make_interp_spline
 from scipy.spatial.transform import Rotation
+
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.orientation import left_jacobian
 
 FloatArray = NDArray[np.float64]
 
@@ -108,39 +111,6 @@ class MinimumJerkPath:
         return self._eval(t, 3)
 
 
-def left_jacobian(phi: ArrayLike) -> FloatArray:
-    """SO(3) left Jacobian J(phi): omega = J(phi) phi' for R = Exp(phi) R0 (world frame)."""
-    v = np.asarray(phi, dtype=float)
-    theta = float(np.linalg.norm(v))
-    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-    if theta < 1e-6:
-        return np.eye(3) + 0.5 * k + k @ k / 6.0
-    return (
-        np.eye(3)
-        + (1.0 - math.cos(theta)) / theta**2 * k
-        + (theta - math.sin(theta)) / theta**3 * (k @ k)
-    )
-
-
-def unwrap_rotation_vector(rotvec: ArrayLike, near: ArrayLike) -> FloatArray:
-    """The rotation vector equivalent to `rotvec` (same rotation) closest to `near`.
-
-    Equivalent vectors are u (theta + 2 pi m) for the unit axis u and integer m; the distance
-    to `near` is smallest for theta + 2 pi m nearest to u . near.
-    """
-    r = np.asarray(rotvec, dtype=float)
-    target = np.asarray(near, dtype=float)
-    theta = float(np.linalg.norm(r))
-    if theta < 1e-12:
-        size = float(np.linalg.norm(target))
-        if size < math.pi:
-            return np.zeros(3)
-        return target / size * (2.0 * math.pi * round(size / (2.0 * math.pi)))
-    axis = r / theta
-    m = round((axis @ target - theta) / (2.0 * math.pi))
-    return axis * (theta + 2.0 * math.pi * m)
-
-
 class MinimumJerkRotation:
     """Minimum-jerk orientation path: the same spline on a rotation vector phi(t).
 
@@ -171,13 +141,13 @@ class MinimumJerkRotation:
                 f"got {len(rotations)}"
             )
         self.start = Rotation.from_quat(quats[0])
-        knots = [np.zeros(3)]
+        knots: list[Any] = [np.zeros(3)]
         for j in range(1, quats.shape[0]):
             rel = (Rotation.from_quat(quats[j]) * self.start.inv()).as_rotvec()
             guess = knots[-1]
             if rotations is not None:
                 guess = guess + _vector_like(rotations[j - 1], 3, f"rotations[{j - 1}]")
-            knots.append(unwrap_rotation_vector(rel, guess))
+            knots.append(np.array(quat.unwrap_rotvec(rel, guess)))
         phi = np.array(knots)
         w0 = _vector_like(omega0, 3, "omega0")
         phi_end_rate = None

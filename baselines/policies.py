@@ -1,8 +1,11 @@
 """One way to name a policy: ``make_policy(spec, env)`` for the CLI and the evaluation harness.
 
-Specs: ``expert``, ``dynamic-constraints``, ``minimum-jerk``, ``random``, or the path of a
-Stable-Baselines3 model ``.zip`` (PPO, SAC, TD3, A2C, DDPG; the algorithm is read from the
-saved data, SB3 and torch are imported only then). A model trained behind ``VecNormalize``
+Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tangent rule),
+``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``dynamic-constraints``,
+``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
+:mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
+TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
+then). A model trained behind ``VecNormalize``
 gets the statistics ``sgc train`` saved beside it (:func:`vecnormalize_path`), so it sees the
 observations it was trained on. Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
@@ -15,7 +18,7 @@ import pickle
 import re
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
@@ -28,11 +31,13 @@ from baselines.comparison_policies import (
     predict_per_env,
 )
 from baselines.expert import SGCExpert
+from baselines.shipped import resolve_policy_spec
 
 __all__ = [
     "BUILTIN_POLICIES",
     "EpisodeExpert",
     "NormalizedPolicy",
+    "Policy",
     "RandomPolicy",
     "algorithm_from_data",
     "load_sb3_model",
@@ -42,8 +47,28 @@ __all__ = [
     "vecnormalize_path",
 ]
 
-BUILTIN_POLICIES: tuple[str, ...] = ("expert", "dynamic-constraints", "minimum-jerk", "random")
+BUILTIN_POLICIES: tuple[str, ...] = (
+    "expert", "expert-paper", "dynamic-constraints", "minimum-jerk", "random"
+)  # fmt: skip
 SB3_ALGORITHMS: tuple[str, ...] = ("PPO", "SAC", "TD3", "A2C", "DDPG")
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """What the harness, the CLI and training callbacks drive: SB3's ``predict`` signature.
+
+    The expert, the comparison controllers, :class:`RandomPolicy`, :class:`EpisodeExpert`,
+    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/test_policies.py``).
+    SB3 models default to ``deterministic=False``; the harness always passes True.
+    """
+
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: np.ndarray | None = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]: ...
 
 
 class RandomPolicy:
@@ -80,8 +105,10 @@ class EpisodeExpert:
     when an episode starts (``episode_start`` or an observation at tick 0).
     """
 
-    def __init__(self, env: Any) -> None:
+    def __init__(self, env: Any, end_rule: str | None = None) -> None:
+        """``end_rule``: passed to each :class:`SGCExpert` (None: the scenario's rule)."""
         self.env = env
+        self.end_rule = end_rule
         self._probe = episode_model(env, 0)
         self._experts: dict[int, SGCExpert] = {}
 
@@ -94,7 +121,8 @@ class EpisodeExpert:
     ) -> tuple[np.ndarray, Any]:
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
-                self._experts[i] = SGCExpert(model=episode_model(self.env, i))
+                model = episode_model(self.env, i)
+                self._experts[i] = SGCExpert(model=model, end_rule=self.end_rule)
             return self._experts[i].action(row)
 
         return predict_per_env(observation, episode_start, row_action), state
@@ -153,12 +181,16 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 def vecnormalize_path(model_path: str | Path) -> Path | None:
     """The ``VecNormalize`` statistics saved with a model by ``sgc train``, if there are any.
 
-    ``final_model.zip``/``best_model.zip`` pair with ``vecnormalize.pkl`` in the same folder;
-    a checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
+    ``<stem>.zip`` pairs with ``<stem>.vecnormalize.pkl`` beside it (shipped models) or else
+    ``vecnormalize.pkl`` in the same folder (``final_model.zip``/``best_model.zip``); a
+    checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
     (SB3's ``CheckpointCallback`` names).
     """
     path = Path(model_path)
     checkpoint = re.fullmatch(r"(.*)_(\d+)_steps", path.stem)
+    own = path.with_name(f"{path.stem}.vecnormalize.pkl")
+    if own.is_file():
+        return own
     if checkpoint:
         stats = path.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps.pkl")
     else:
@@ -230,16 +262,19 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
         )
 
 
-def make_policy(spec: str, env: Any, seed: int | None = None) -> Any:
+def make_policy(spec: str, env: Any, seed: int | None = None) -> Policy:
     """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``."""
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
+    spec = resolve_policy_spec(spec)
     if spec == "random":
         return RandomPolicy(env.action_space, seed)
-    if spec in ("expert", "dynamic-constraints", "minimum-jerk"):
+    if spec in ("expert", "expert-paper", "dynamic-constraints", "minimum-jerk"):
         _needs_flat_observation(env, spec)
         if spec == "expert":
             return EpisodeExpert(env)
+        if spec == "expert-paper":
+            return EpisodeExpert(env, end_rule="paper")
         if spec == "dynamic-constraints":
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)

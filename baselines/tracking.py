@@ -18,7 +18,7 @@ costs more than the arithmetic (see ``scripts/bench_expert.py``).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -88,8 +88,8 @@ def simulate_rotation(
 
 
 def _simulate_axisymmetric(
-    q: Quat, w: Vec3, torque: Vec3, inertia: Vec, h: float, n: int
-) -> tuple[tuple[float, float, float, float], Vec3]:
+    q: Quat, w: Vec, torque: Vec, inertia: Vec, h: float, n: int
+) -> tuple[Quat, Vec3]:
     """:func:`simulate_rotation` for ``I0 == I1`` with ``Iw = I0 Id + (I2 - I0) a a^T``.
 
     Equal to the matrix form up to rounding; about half its cost.
@@ -164,7 +164,7 @@ def torque_for_orientation(
 
     # between goals the correction runs on the cheaper closed form of an axisymmetric body;
     # goal ticks use the matrix form, which follows PyBullet's own arithmetic more closely
-    simulate = simulate_rotation
+    simulate: Callable[..., tuple[Quat, Vec3]] = simulate_rotation
     if not exact and inertia[0] == inertia[1]:
         simulate = _simulate_axisymmetric
 

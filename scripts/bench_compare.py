@@ -3,9 +3,10 @@
 Imports ``sgc_env`` of ``--reference`` (another worktree, e.g. ``git worktree add /tmp/base
 <commit>``), keeps its env class, then imports this checkout's ``sgc_env`` in its place. For
 every registered id both envs run the same scenario under a hover action in alternating chunks
-(``--rounds`` each); the best chunk per side is kept, in wall time and in process CPU time, so
-a busy, shared machine only ever slows a chunk down and both sides see the same machine. Prints
-microseconds per step for both and the cost ratio new / reference (1.000 = same cost).
+(``--rounds`` each, the order flipped every round). The best chunk per side is kept, in wall
+time and in process CPU time, so a busy, shared machine only ever slows a chunk down and both
+sides see the same machine. Prints microseconds per step for both and the cost ratio
+new / reference (1.000 = same cost).
 
     .venv/bin/python scripts/bench_compare.py --reference /tmp/base [--rounds 40 --chunk 500]
 """
@@ -75,9 +76,9 @@ def main() -> None:
         envs = {"ref": fixed_env(reference, kwargs), "new": fixed_env(new, kwargs)}
         action = hover_action(envs["new"])
         best = {side: [float("inf"), float("inf")] for side in envs}
-        for _ in range(args.rounds):
-            for side, env in envs.items():
-                wall, cpu = chunk_us(env, args.chunk, action)
+        for r in range(args.rounds):
+            for side in ("ref", "new") if r % 2 == 0 else ("new", "ref"):  # ABBA: no order bias
+                wall, cpu = chunk_us(envs[side], args.chunk, action)
                 best[side] = [min(best[side][0], wall), min(best[side][1], cpu)]
         (rw, rc), (nw, nc) = best["ref"], best["new"]
         print(

@@ -1,17 +1,21 @@
 """sgc_env: Gymnasium environments for sequential-goal constraints (Liu, Ko & Chang 1993).
 
-Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium.
+Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium, each with the
+``max_episode_steps`` of its episodes (:mod:`sgc_env.episode_steps`).
 """
 
 from __future__ import annotations
 
 import gymnasium as gym
+from gymnasium.envs.registration import WrapperSpec
 
+from sgc_env.episode_steps import registered_steps
 from sgc_env.observation import ObservationLayout
 from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_scenario
 
 __all__ = [
     "ENV_IDS",
+    "check_env_id",
     "Body",
     "Goal",
     "ObservationLayout",
@@ -22,15 +26,38 @@ __all__ = [
 ]
 
 _ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
+_GOAL = "sgc_env.envs.goal_env"
+_STEPS = "sgc_env.episode_steps"
 _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
     "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
-    "SGCPointGoal-v0": ("sgc_env.envs.goal_env:SGCGoalEnv", {"random_scenario": "point"}),
+    "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
+    "SGCThreeRodsRandom-v0": (_ENTRY, {"random_scenario": "three_rods"}),
+    "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 
+_LENGTH_CHECK = WrapperSpec("EpisodeLengthCheck", f"{_STEPS}:EpisodeLengthCheck", {})
+_GOAL_REWARD = WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {})
+
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
-        gym.register(id=_id, entry_point=_entry, kwargs=_kwargs)
+        gym.register(
+            id=_id,
+            entry_point=_entry,
+            kwargs=_kwargs,
+            max_episode_steps=registered_steps(_kwargs),
+            additional_wrappers=(
+                (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else (_LENGTH_CHECK,)
+            ),
+        )
+
+
+def check_env_id(env_id: object, field: str = "env_id") -> str:
+    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
+    SGC ids (the one check of the package, the harness, training and the CLI)."""
+    if not isinstance(env_id, str) or env_id not in gym.registry:
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")
+    return env_id

@@ -163,17 +163,6 @@ class ObservationLayout:
             start += n
         raise KeyError(f"unknown global field {field_name!r}")
 
-    def field_slices(self) -> dict[str, slice]:
-        """Every entry by a qualified name ``'<body>.<field>'`` (body index or name) and globals."""
-        out: dict[str, slice] = {}
-        for i in range(self.n_bodies):
-            label = self.body_names[i] if self.body_names else str(i)
-            for name, _ in BODY_FIELDS:
-                out[f"{label}.{name}"] = self.body_slice(i, name)
-        for name, _ in GLOBAL_FIELDS:
-            out[name] = self.global_slice(name)
-        return out
-
     def unpack(self, observation: np.ndarray) -> list[dict[str, np.ndarray]]:
         """Per-body dictionaries of views into ``observation`` (for debugging and tests)."""
         obs = np.asarray(observation)

@@ -50,7 +50,8 @@ class CameraConfig:
             raise ValueError(
                 f"camera: unknown option(s) {unknown}; expected some of {sorted(known)}"
             )
-        cfg = cls(**{k: (tuple(v) if k == "target" else v) for k, v in options.items()})
+        values: dict[str, Any] = {k: (tuple(v) if k == "target" else v) for k, v in options.items()}
+        cfg = cls(**values)
         if not (int(cfg.width) > 0 and int(cfg.height) > 0):
             raise ValueError(
                 f"camera: width and height must be positive, got {cfg.width}x{cfg.height}"

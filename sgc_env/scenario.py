@@ -4,13 +4,25 @@ A scenario is plain frozen data. ``resolve_scenario`` turns a user scenario into
 environment runs: every goal gets a time on the control grid (non-critical times from the
 routing weights of ``sgc_env.paper.routing``), nails bound to props are computed from the
 prop's scripted path, and every field is checked with a message that names the field path.
+
+Numbers are checked against ``LIMITS`` (name -> low, high, unit, where the bound comes from),
+so that nothing that loads can overflow the float32 observation (bounds +-1e5), leave what
+PyBullet simulates faithfully, or make the work of loading and running unbounded. After
+resolution the analytic plan is checked against the force and torque limits, the workspace and
+PyBullet's speed clamps (:mod:`sgc_env.feasibility`); ``allow_saturation: true`` opts out of
+the force and torque part for users who want saturated actuators.
+
+YAML: the loader reads numbers as YAML 1.2 does, so ``1e0`` is the float 1.0 (plain YAML 1.1,
+PyYAML's default, needs a dot and reads it as a string).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -19,6 +31,7 @@ import numpy as np
 import yaml
 
 from sgc_env.paper import quaternion as quat
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
 from sgc_env.paper.routing import resolve_goal_times
 
 __all__ = [
@@ -44,6 +57,37 @@ SHAPES: dict[str, tuple[str, ...]] = {
 TIME_GRID_MODES = ("reject", "snap")
 _TICK_TOL = 1e-9
 WORKSPACE_LIMIT = 1e4  # keeps every observation entry inside the env's +-1e5 bounds
+MAX_EPISODE_STEPS = 100_000  # control ticks; the harness's default episode cap
+MAX_PATH_SAMPLES = 1_000
+MAX_GOALS = 10_000  # per body
+MAX_WAYPOINTS = 10_000  # per prop
+MAX_HELIX_TURNS = 1_000
+
+LIMITS: dict[str, tuple[float, float, str, str]] = {
+    "mass": (1e-6, 1e6, "kg",
+             "PyBullet makes a body of mass <= ~1e-16 static; 1e-6 keeps ten orders of margin"),
+    "size": (1e-3, 1e3, "m",
+             "inertia ~ m size^2 must stay far from underflow; a body fits the workspace"),
+    "force_limit": (1e-9, 1e7, "N", "forces are reported in float32 (7 significant digits)"),
+    "torque_limit": (1e-9, 1e7, "N m", "torques are reported in float32 (7 significant digits)"),
+    "speed": (0.0, 90.0, "m/s", "PyBullet clamps linear speed at 100 m/s; the env ends at 90"),
+    "spin": (0.0, 99.0, "rad/s", "PyBullet clamps angular speed at 100 rad/s"),
+    "coordinate": (-WORKSPACE_LIMIT, WORKSPACE_LIMIT, "m",
+                   "positions and deviations stay inside the observation bounds +-1e5"),
+    "point": (0.0, WORKSPACE_LIMIT, "m",
+              "the tracked point's offset is observed (bounds +-1e5)"),
+    "time": (0.0, 1e4, "s",
+             "float32 time in the observation still resolves 1 ms; the episode cap is "
+             f"{MAX_EPISODE_STEPS} ticks"),
+    "margin": (0.0, 1e3, "s", "the episode runs this long after the last goal"),
+    "relative_rotation": (0.0, 64 * math.pi, "rad",  # = paper.orientation.MAX_RELATIVE_ROTATION
+                          "32 turns (96 planner courses of 2 pi / 3) per goal"),
+    "gravity": (0.0, 1e3, "m/s^2", "about 100 g; forces to hold a body must stay reportable"),
+    "weight": (1e-9, 1e9, "", "routing divides by weights; their ratios set goal times"),
+    "control_frequency": (1, 1000, "Hz", "the simulation runs an integer multiple of it"),
+    "color": (0.0, 1.0, "", "RGBA components"),
+    "prop_velocity": (0.0, 1e3, "m/s", "a prop must stay near the workspace for its episode"),
+}  # fmt: skip
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -138,7 +182,11 @@ class Prop:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A whole scene. ``resolved`` is set by :func:`resolve_scenario` (all goal times filled)."""
+    """A whole scene. ``resolved`` is set by :func:`resolve_scenario` (all goal times filled).
+
+    ``allow_saturation``: accept goals whose plan needs more force or torque than the limits
+    (the actuators then saturate and goals may be missed); by default that is an error.
+    """
 
     bodies: tuple[Body, ...]
     props: tuple[Prop, ...] = ()
@@ -148,6 +196,8 @@ class Scenario:
     margin: float = 0.25
     control_frequency: int = 60
     time_grid: str = "reject"
+    end_velocity_rule: str = DEFAULT_END_RULE
+    allow_saturation: bool = False
     resolved: bool = field(default=False, compare=False)
 
     def body_index(self, name: str) -> int:
@@ -155,12 +205,6 @@ class Scenario:
             if b.name == name:
                 return i
         raise KeyError(f"no body named {name!r}")
-
-    @property
-    def last_goal_time(self) -> float:
-        if not self.resolved:
-            raise ScenarioError("scenario is not resolved: call resolve_scenario first")
-        return max(float(g.time) for b in self.bodies for g in b.goals)  # type: ignore[arg-type]
 
 
 # ---------------------------------------------------------------- point-to-path goals
@@ -196,7 +240,7 @@ def parametric_curve(kind: str, **params: Any) -> Callable[[float], np.ndarray]:
 
 
 def path_goals(
-    path: Callable[[float], Sequence[float]],
+    path: Callable[[float], Sequence[float] | np.ndarray],
     samples: int,
     *,
     time: float | None = None,
@@ -244,7 +288,7 @@ def _fail(path: str, msg: str) -> ScenarioError:
 def _number(value: Any, path: str, *, positive: bool = False, nonneg: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         kind = "a positive number" if positive else "a number"
-        raise _fail(path, f"expected {kind}, got {value!r}")
+        raise _fail(path, f"expected {kind}, got {value!r}{_quoted_hint(value)}")
     v = float(value)
     if not math.isfinite(v):
         raise _fail(path, f"expected a finite number, got {value!r}")
@@ -255,6 +299,17 @@ def _number(value: Any, path: str, *, positive: bool = False, nonneg: bool = Fal
     return v
 
 
+def _quoted_hint(value: Any) -> str:
+    """Why a number arrived as a string: it was quoted in the YAML file."""
+    if isinstance(value, str):
+        try:
+            float(value)
+        except ValueError:
+            return ""
+        return " (a string: YAML reads a quoted number as text; remove the quotes)"
+    return ""
+
+
 def _vector(value: Any, n: int, path: str) -> tuple[float, ...]:
     if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
         raise _fail(path, f"expected a list of {n} numbers, got {value!r}")
@@ -263,7 +318,7 @@ def _vector(value: Any, n: int, path: str) -> tuple[float, ...]:
     out = []
     for x in value:
         if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
-            raise _fail(path, f"expected {n} numbers, got {list(value)!r}")
+            raise _fail(path, f"expected {n} numbers, got {list(value)!r}{_quoted_hint(x)}")
         out.append(float(x))
     if any(math.isnan(x) for x in out):
         raise _fail(path, "contains NaN")
@@ -300,6 +355,31 @@ def _require(d: Mapping[str, Any], key: str, path: str) -> Any:
     return d[key]
 
 
+def _limit_text(key: str) -> str:
+    lo, hi, unit, why = LIMITS[key]
+    unit = f" {unit}" if unit else ""
+    return f"[{lo:g}, {hi:g}]{unit} ({why})"
+
+
+def _in_range(value: float, key: str, path: str) -> float:
+    """``value`` inside ``LIMITS[key]``, else a message with the bound and its reason."""
+    lo, hi, unit, _ = LIMITS[key]
+    if not lo <= value <= hi:
+        raise _fail(path, f"{value!r} is outside {_limit_text(key)}")
+    return value
+
+
+def _norm_in_range(vec: Sequence[float], key: str, path: str) -> None:
+    norm = math.sqrt(math.fsum(x * x for x in vec))
+    if not math.isfinite(norm) or norm > LIMITS[key][1]:
+        raise _fail(path, f"magnitude {norm:.6g} of {tuple(vec)} is outside {_limit_text(key)}")
+
+
+def _coords_in_range(vec: Sequence[float], path: str) -> None:
+    for x in vec:
+        _in_range(x, "coordinate", path)
+
+
 _GOAL_KEYS = {"nail", "point", "orientation", "relative_rotation", "time", "critical", "weight"}
 _PATH_KEYS = {"path", "samples", "point", "time", "weight"}
 
@@ -307,6 +387,8 @@ _PATH_KEYS = {"path", "samples", "point", "time", "weight"}
 def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
     if not isinstance(raw, list):
         raise _fail(path, f"expected a list of goals, got {type(raw).__name__}")
+    if len(raw) > MAX_GOALS:
+        raise _fail(path, f"{len(raw)} goals; at most {MAX_GOALS} per body")
     goals: list[Goal] = []
     for j, g in enumerate(raw):
         p = f"{path}[{j}]"
@@ -353,7 +435,17 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
     samples = _require(g, "samples", p)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise _fail(f"{p}.samples", f"expected an integer >= 1, got {samples!r}")
+    if samples > MAX_PATH_SAMPLES:
+        raise _fail(
+            f"{p}.samples",
+            f"{samples} samples; at most {MAX_PATH_SAMPLES} (each sample is a goal of its own, "
+            "and needs at least one control tick)",
+        )
     spec.pop("curve")
+    turns = spec.get("turns")
+    if isinstance(turns, int | float) and not isinstance(turns, bool):
+        if not abs(turns) <= MAX_HELIX_TURNS:
+            raise _fail(f"{p}.path.turns", f"{turns!r}: at most {MAX_HELIX_TURNS} turns")
     try:
         curve = parametric_curve(str(kind), **spec)
         pts = np.asarray([curve(s) for s in (0.0, 0.5, 1.0)], float)
@@ -381,7 +473,7 @@ _BODY_KEYS = {
 _PROP_KEYS = {"name", "shape", "size", "color", "position", "velocity", "waypoints", "collisions"}
 _SCENARIO_KEYS = {
     "name", "bodies", "props", "goals", "gravity", "workspace", "margin", "control_frequency",
-    "time_grid",
+    "time_grid", "allow_saturation", "end_velocity_rule",
 }  # fmt: skip
 
 
@@ -455,6 +547,8 @@ def _parse_prop(d: Any, path: str) -> Prop:
         wps = d["waypoints"]
         if not isinstance(wps, list) or not wps:
             raise _fail(f"{path}.waypoints", "expected a non-empty list of {time, position}")
+        if len(wps) > MAX_WAYPOINTS:
+            raise _fail(f"{path}.waypoints", f"{len(wps)} waypoints; at most {MAX_WAYPOINTS}")
         out = []
         for i, w in enumerate(wps):
             wp = f"{path}.waypoints[{i}]"
@@ -513,10 +607,20 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
         kw["control_frequency"] = cf
     if "time_grid" in d:
         kw["time_grid"] = d["time_grid"]
+    if "allow_saturation" in d:
+        kw["allow_saturation"] = _bool(d["allow_saturation"], "allow_saturation")
+    if "end_velocity_rule" in d:
+        kw["end_velocity_rule"] = d["end_velocity_rule"]
     return Scenario(**kw)
 
 
 # ---------------------------------------------------------------- semantic validation
+
+
+_VELOCITY_LIMITS = (
+    ("linear_velocity", "speed"), ("angular_velocity", "spin"),
+    ("end_velocity", "speed"), ("end_angular_velocity", "spin"),
+)  # fmt: skip
 
 
 def _validate_structure(s: Scenario) -> None:
@@ -524,11 +628,16 @@ def _validate_structure(s: Scenario) -> None:
         raise _fail("bodies", "expected at least one body")
     if s.time_grid not in TIME_GRID_MODES:
         raise _fail("time_grid", f"expected one of {TIME_GRID_MODES}, got {s.time_grid!r}")
+    if s.end_velocity_rule not in END_RULES:
+        raise _fail(
+            "end_velocity_rule", f"expected one of {END_RULES}, got {s.end_velocity_rule!r}"
+        )
     if not (isinstance(s.control_frequency, int) and s.control_frequency > 0):
         raise _fail(
             "control_frequency", f"expected a positive integer, got {s.control_frequency!r}"
         )
-    _vector(s.gravity, 3, "gravity")
+    _in_range(s.control_frequency, "control_frequency", "control_frequency")
+    _norm_in_range(_vector(s.gravity, 3, "gravity"), "gravity", "gravity")
     lo, hi = (
         _vector(s.workspace[0], 3, "workspace.low"),
         _vector(s.workspace[1], 3, "workspace.high"),
@@ -537,7 +646,9 @@ def _validate_structure(s: Scenario) -> None:
         raise _fail("workspace", f"low {lo} must be below high {hi} in every axis")
     if max(map(abs, lo + hi)) > WORKSPACE_LIMIT:
         raise _fail("workspace", f"must lie inside +-{WORKSPACE_LIMIT:g} m, got {lo} .. {hi}")
-    _number(s.margin, "margin", nonneg=True)
+    _in_range(_number(s.margin, "margin", nonneg=True), "margin", "margin")
+    if not isinstance(s.allow_saturation, bool):
+        raise _fail("allow_saturation", f"expected true or false, got {s.allow_saturation!r}")
     names: set[str] = set()
     prop_names = {p.name for p in s.props}
     for i, b in enumerate(s.bodies):
@@ -546,9 +657,9 @@ def _validate_structure(s: Scenario) -> None:
             raise _fail(f"{p}.name", f"duplicate name {b.name!r}")
         names.add(b.name)
         _validate_shape(b.shape, b.size, p)
-        _number(b.mass, f"{p}.mass", positive=True)
-        _number(b.force_limit, f"{p}.force_limit", positive=True)
-        _number(b.torque_limit, f"{p}.torque_limit", positive=True)
+        _validate_color(b.color, f"{p}.color")
+        for key in ("mass", "force_limit", "torque_limit"):
+            _in_range(_number(getattr(b, key), f"{p}.{key}", positive=True), key, f"{p}.{key}")
         weight = b.mass * float(np.linalg.norm(s.gravity))
         if b.force_limit <= weight:
             raise _fail(
@@ -556,12 +667,16 @@ def _validate_structure(s: Scenario) -> None:
                 f"{b.force_limit} N cannot hold the body against gravity "
                 f"(mass*|g| = {weight:.4g} N)",
             )
-        for key in ("position", "linear_velocity", "angular_velocity"):
-            _vector(getattr(b, key), 3, f"{p}.{key}")
+        _vector(b.position, 3, f"{p}.position")
+        for key, limit in _VELOCITY_LIMITS:
+            if getattr(b, key) is not None:
+                _norm_in_range(_vector(getattr(b, key), 3, f"{p}.{key}"), limit, f"{p}.{key}")
         _quaternion(b.orientation, f"{p}.orientation")
         _check_inside(b.position, s.workspace, f"{p}.position")
         if not b.goals:
             raise _fail(f"{p}.goals", "empty goal list; every body needs at least one goal")
+        if len(b.goals) > MAX_GOALS:
+            raise _fail(f"{p}.goals", f"{len(b.goals)} goals; at most {MAX_GOALS} per body")
         for j, g in enumerate(b.goals):
             _validate_goal(g, f"{p}.goals[{j}]", prop_names, s.workspace, s.resolved)
     seen = set(names)
@@ -571,13 +686,20 @@ def _validate_structure(s: Scenario) -> None:
             raise _fail(f"{p}.name", f"expected a unique non-empty string, got {pr.name!r}")
         seen.add(pr.name)
         _validate_shape(pr.shape, pr.size, p)
+        _validate_color(pr.color, f"{p}.color")
+        _coords_in_range(_vector(pr.position, 3, f"{p}.position"), f"{p}.position")
+        _norm_in_range(_vector(pr.velocity, 3, f"{p}.velocity"), "prop_velocity", f"{p}.velocity")
+        if len(pr.waypoints) > MAX_WAYPOINTS:
+            raise _fail(f"{p}.waypoints", f"{len(pr.waypoints)} waypoints; at most {MAX_WAYPOINTS}")
         last = -math.inf
         for k, (t, pos) in enumerate(pr.waypoints):
+            wp = f"{p}.waypoints[{k}]"
+            t = _number(t, f"{wp}.time")
+            if not abs(t) <= LIMITS["time"][1]:
+                raise _fail(f"{wp}.time", f"{t!r} is outside +-{_limit_text('time')}")
             if t <= last:
-                raise _fail(
-                    f"{p}.waypoints[{k}].time", f"{t} is not after the previous time {last}"
-                )
-            _vector(pos, 3, f"{p}.waypoints[{k}].position")
+                raise _fail(f"{wp}.time", f"{t} is not after the previous time {last}")
+            _coords_in_range(_vector(pos, 3, f"{wp}.position"), f"{wp}.position")
             last = t
 
 
@@ -588,7 +710,12 @@ def _validate_shape(shape: Any, size: tuple[float, ...], p: str) -> None:
     if len(size) != len(need):
         raise _fail(f"{p}.size", f"a {shape} needs {len(need)} numbers {need}, got {list(size)}")
     for k, v in enumerate(size):
-        _number(v, f"{p}.size[{k}]", positive=True)
+        _in_range(_number(v, f"{p}.size[{k}]", positive=True), "size", f"{p}.size[{k}]")
+
+
+def _validate_color(color: Sequence[float], path: str) -> None:
+    for x in _vector(color, 4, path):
+        _in_range(x, "color", path)
 
 
 def _check_inside(pos: Sequence[float], ws: tuple[Vec3, Vec3], path: str) -> None:
@@ -608,20 +735,23 @@ def _validate_goal(
         _check_inside(g.nail, ws, f"{p}.nail")
     if g.nail_prop is not None and g.nail_prop not in prop_names:
         raise _fail(f"{p}.nail.prop", f"refers to unknown prop {g.nail_prop!r}")
-    _vector(g.point, 3, f"{p}.point")
+    _norm_in_range(_vector(g.point, 3, f"{p}.point"), "point", f"{p}.point")
     if g.orientation is not None and g.relative_rotation is not None:
         raise _fail(p, "give either orientation or relative_rotation, not both")
     if g.orientation is not None:
         _quaternion(g.orientation, f"{p}.orientation")
     if g.relative_rotation is not None:
-        _vector(g.relative_rotation, 3, f"{p}.relative_rotation")
+        rel = _vector(g.relative_rotation, 3, f"{p}.relative_rotation")
+        _norm_in_range(rel, "relative_rotation", f"{p}.relative_rotation")
     w = _number(g.weight, f"{p}.weight")
     if w <= 0:
         raise _fail(f"{p}.weight", f"routing weight must be > 0, got {w!r}")
+    _in_range(w, "weight", f"{p}.weight")
     if g.time is not None:
         t = _number(g.time, f"{p}.time")
         if t <= 0:
             raise _fail(f"{p}.time", f"{t} is not after the start time 0")
+        _in_range(t, "time", f"{p}.time")
     if g.nail_prop is not None and not g.is_critical:
         raise _fail(
             f"{p}.time", "an interception goal (nail bound to a prop) must be time-critical"
@@ -659,7 +789,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
     distances: list[float] = []
     weights: list[float] = []
     prev_point: np.ndarray | None = None
-    prev_q = np.asarray(b.orientation, float)
+    prev_q: Any = np.asarray(b.orientation, float)
     for j, g in enumerate(b.goals):
         gp = f"{p}.goals[{j}]"
         crit = g.is_critical
@@ -685,6 +815,7 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
             dist = float(np.linalg.norm(nail - prev_point)) if nail is not None else 0.0
             prev_point = nail
         if g.has_orientation:
+            q: Any
             if g.relative_rotation is not None:
                 angle = float(np.linalg.norm(g.relative_rotation))
                 q = quat.mul(quat.exp_normalized(g.relative_rotation), prev_q)
@@ -731,13 +862,69 @@ def _goal_nail(g: Goal, s: Scenario, t: float | None) -> np.ndarray | None:
     return None
 
 
+def _goal_at(b: Body, t: float) -> int:
+    """Index of the goal whose course contains time ``t`` (the first goal not before it)."""
+    for j, g in enumerate(b.goals):
+        if float(g.time) >= t - 1e-9:  # type: ignore[arg-type]
+            return j
+    return len(b.goals) - 1
+
+
+@lru_cache(maxsize=64)
+def _check_plan(s: Scenario) -> None:
+    """The analytic plan against the limits (cached: scenarios are frozen and hashable)."""
+    from sgc_env.feasibility import body_demand
+
+    for i, b in enumerate(s.bodies):
+        p = f"bodies[{i}]"
+        try:
+            d = body_demand(s, b)
+        except ValueError as exc:  # goals the planner cannot plan (e.g. too few ticks)
+            raise _fail(f"{p}.goals", str(exc)) from None
+        if d.outside_time is not None:
+            raise _fail(
+                f"{p}.goals[{_goal_at(b, d.outside_time)}]",
+                f"the planned path leaves the workspace at t = {d.outside_time:.4g} s; "
+                "widen the workspace or move the goal",
+            )
+        for value, when, key, what in (
+            (d.speed, d.speed_time, "speed", "a speed"), (d.spin, d.spin_time, "spin", "a spin")
+        ):  # fmt: skip
+            if value > LIMITS[key][1]:
+                raise _fail(
+                    f"{p}.goals[{_goal_at(b, when)}]",
+                    f"the plan needs {what} of {value:.4g} {LIMITS[key][2]} near t = "
+                    f"{when:.4g} s, above {LIMITS[key][1]:g} ({LIMITS[key][3]}); give it more time",
+                )
+        if s.allow_saturation:
+            continue
+        for value, when, key, unit in (
+            (d.force, d.force_time, "force_limit", "N"),
+            (d.torque, d.torque_time, "torque_limit", "N m"),
+        ):
+            limit = float(getattr(b, key))
+            if value > limit:
+                raise _fail(
+                    f"{p}.goals[{_goal_at(b, when)}]",
+                    f"the plan needs a peak {key[:-6]} of {value:.4g} {unit} near t = "
+                    f"{when:.4g} s, above {p}.{key} = {limit:g} {unit}; raise the limit, give "
+                    "the goal more time, or set allow_saturation: true to accept saturation",
+                )
+
+
 def resolve_scenario(
-    scenario: Scenario, *, control_frequency: int | None = None, time_grid: str | None = None
+    scenario: Scenario,
+    *,
+    control_frequency: int | None = None,
+    time_grid: str | None = None,
+    check_plan: bool = True,
 ) -> Scenario:
     """Validate ``scenario`` and fill in every goal time (on the control grid) and prop nail.
 
     ``control_frequency``/``time_grid`` override the scenario's. Idempotent on a resolved
-    scenario (non-critical times are re-routed from the critical ones).
+    scenario (non-critical times are re-routed from the critical ones). ``check_plan``: check
+    the analytic plan against the limits (see :func:`_check_plan`); callers with a cheaper
+    guarantee of their own (``random_scenarios``) turn it off.
     """
     s = scenario
     if control_frequency is not None:
@@ -749,7 +936,7 @@ def resolve_scenario(
     for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
         times = _body_goal_times(b, s, s.control_frequency, s.time_grid, p)
-        goals = []
+        goals: list[Goal] = []
         for g, t in zip(b.goals, times, strict=True):
             nail = g.nail
             if g.nail_prop is not None:
@@ -758,7 +945,19 @@ def resolve_scenario(
                 _check_inside(nail, s.workspace, f"{p}.goals[{len(goals)}].nail")  # type: ignore[arg-type]
             goals.append(replace(g, time=t, critical=g.is_critical, nail=nail))
         bodies.append(replace(b, goals=tuple(goals)))
-    return replace(s, bodies=tuple(bodies), resolved=True)
+    out = replace(s, bodies=tuple(bodies), resolved=True)
+    last = max(round(float(g.time) * s.control_frequency) for b in bodies for g in b.goals)  # type: ignore[arg-type]
+    steps = last + math.ceil(s.margin * s.control_frequency - 1e-9)
+    if steps > MAX_EPISODE_STEPS:
+        raise _fail(
+            "goals",
+            f"the episode would last {steps} control ticks (last goal at {last} ticks plus the "
+            f"margin); at most {MAX_EPISODE_STEPS}: use shorter goal times or a lower "
+            "control_frequency",
+        )
+    if check_plan:
+        _check_plan(out)
+    return out
 
 
 # ---------------------------------------------------------------- loading
@@ -776,7 +975,7 @@ def load_scenario(path_or_name: str | Path | Scenario) -> Scenario:
         return resolve_scenario(path_or_name)
     path = Path(path_or_name)
     if path.suffix in (".yaml", ".yml") and path.exists():
-        text = path.read_text()
+        text = _read_text(path)
         name = path.stem
     else:
         res = resources.files("sgc_env") / "scenarios" / f"{path_or_name}.yaml"
@@ -788,7 +987,38 @@ def load_scenario(path_or_name: str | Path | Scenario) -> Scenario:
         text = res.read_text()
         name = str(path_or_name)
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=_Loader)  # noqa: S506 (a SafeLoader)
     except yaml.YAMLError as exc:
         raise ScenarioError(f"{name}: not valid YAML: {exc}") from None
-    return resolve_scenario(scenario_from_dict(data, name=name))
+    except RecursionError:
+        raise ScenarioError(f"{name}: nested too deeply to read") from None
+    try:
+        return resolve_scenario(scenario_from_dict(data, name=name))
+    except RecursionError:
+        raise ScenarioError(f"{name}: nested too deeply to read") from None
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader with YAML 1.2 floats: ``1e0`` and ``1E-3`` are numbers (YAML 1.1
+    asks for a dot and reads them as strings, which surprises everyone)."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
+def _read_text(path: Path) -> str:
+    """The file's text, or a ScenarioError naming the file and what is wrong with it."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except IsADirectoryError:
+        raise ScenarioError(f"{path}: is a directory, not a scenario file") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason}); save it as UTF-8"
+        ) from None
+    except OSError as exc:
+        raise ScenarioError(f"{path}: cannot read: {exc.strerror or exc}") from None

@@ -14,13 +14,14 @@ import contextlib
 import os
 import sys
 import tempfile
+import weakref
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["BodyHandle", "BodyState", "Drive", "Simulator", "pybullet"]
+__all__ = ["BodyHandle", "BodyState", "Drive", "Simulator", "connected_clients", "pybullet"]
 
 BodyState = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]
 """One body as read back: position, quaternion xyzw, linear and angular velocity (world)."""
@@ -70,8 +71,26 @@ class BodyHandle:
     mass: float
 
 
+MAX_CLIENTS = 1024  # PyBullet's limit on physics clients per process (ids are reused)
+
+
+def _disconnect(client: int) -> None:
+    with contextlib.suppress(Exception):
+        pybullet.disconnect(physicsClientId=client)
+
+
+def connected_clients() -> list[int]:
+    """Ids of the PyBullet clients this process has connected (for leak checks)."""
+    info = pybullet.getConnectionInfo
+    return [c for c in range(MAX_CLIENTS) if info(physicsClientId=c)["isConnected"]]
+
+
 class Simulator:
-    """A PyBullet client (DIRECT, or GUI for ``render_mode='human'``) holding named bodies."""
+    """A PyBullet client (DIRECT, or GUI for ``render_mode='human'``) holding named bodies.
+
+    The client is disconnected by :meth:`close` or, failing that, when the simulator is
+    garbage-collected.
+    """
 
     def __init__(self, *, gui: bool = False, sim_frequency: int = 240) -> None:
         pb = pybullet
@@ -84,6 +103,9 @@ class Simulator:
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         if self.client < 0:
             raise RuntimeError("could not connect to PyBullet (is another GUI client open?)")
+        # Frees the client when the simulator is garbage-collected unclosed (each one holds
+        # ~30 MB); close() runs the same finaliser at once.
+        self._finalizer = weakref.finalize(self, _disconnect, self.client)
         pb.setTimeStep(1.0 / self.sim_frequency, physicsClientId=self.client)
         if gui:
             pb.configureDebugVisualizer(pb.COV_ENABLE_GUI, 0, physicsClientId=self.client)
@@ -286,7 +308,6 @@ class Simulator:
         )
 
     def close(self) -> None:
-        if self.client >= 0:
-            with contextlib.suppress(Exception):
-                pybullet.disconnect(physicsClientId=self.client)
-            self.client = -1
+        """Disconnect (idempotent); later calls on this simulator fail in PyBullet."""
+        self._finalizer()
+        self.client = -1

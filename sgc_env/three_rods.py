@@ -15,12 +15,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
-from scipy.interpolate import make_interp_spline
-from scipy.spatial.transform import Rotation
+
+if TYPE_CHECKING:  # scipy is imported where a scene is built: constants stay cheap to import
+    from scipy.spatial.transform import Rotation
 
 __all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
 
@@ -46,7 +47,7 @@ YAML_PATH = Path(__file__).parent / "scenarios" / "three_rods.yaml"
 class RodSpec:
     """One rod: its tip's designated path, how it is sampled, and its red ball and target hit.
 
-    ``waypoints[ball_index]`` is where the tip pierces the ball at ``PIERCE_TIME``; the last
+    ``waypoints[ball_index]`` is where the tip pierces the ball at ``pierce_time``; the last
     waypoint is on the target face, hit at ``hit_time``. The tip path is the cubic spline
     through the waypoints; ``samples_before`` goals lie on the path up to the ball (the ball
     included), ``samples_after`` from there to the target (the hit included), and one more goal
@@ -64,6 +65,7 @@ class RodSpec:
     somersault_sample: int | None = None
     somersault_weight: float = 0.3
     """Routing weight of the somersault's course: the rod slows down to turn over."""
+    pierce_time: float = PIERCE_TIME
 
     @property
     def goal_count(self) -> int:
@@ -119,6 +121,8 @@ def _spline(points: np.ndarray):
     """Cubic spline through ``points`` parametrised by cumulative chord length."""
     chord = np.linalg.norm(np.diff(points, axis=0), axis=1)
     knots = np.concatenate(([0.0], np.cumsum(chord)))
+    from scipy.interpolate import make_interp_spline
+
     return make_interp_spline(knots, points, k=3), knots
 
 
@@ -135,6 +139,8 @@ def _arc_length_samples(spline, s0: float, s1: float, count: int) -> np.ndarray:
 
 def _align(previous: Rotation, tangent: np.ndarray) -> Rotation:
     """``previous`` turned by the smallest rotation that points its z axis along ``tangent``."""
+    from scipy.spatial.transform import Rotation
+
     axis_now = previous.apply([0.0, 0.0, 1.0])
     t = tangent / np.linalg.norm(tangent)
     cross = np.cross(axis_now, t)
@@ -163,6 +169,8 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
             _arc_length_samples(spline, knots[spec.ball_index], knots[-1], spec.samples_after),
         )
     )
+    from scipy.spatial.transform import Rotation
+
     start = Rotation.identity()
     start = _align(_align(start, np.array([1.0, 0.0, 0.0])), tangent(knots[0]))
     tip_start = points[0]
@@ -176,7 +184,7 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
         goal: dict[str, Any] = {"point": list(TIP)}
         if j == pierce:
             goal["nail"] = {"prop": f"ball_{spec.name[4:]}"}
-            goal["time"] = PIERCE_TIME
+            goal["time"] = spec.pierce_time
         else:
             goal["nail"] = _vec(spline(s))
         if j == len(params) - 1:
@@ -226,17 +234,19 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
         "shape": "sphere",
         "size": [BALL_RADIUS],
         "color": [0.85, 0.08, 0.08, 1.0],
-        "position": _vec(ball_at_pierce - velocity * PIERCE_TIME),
+        "position": _vec(ball_at_pierce - velocity * spec.pierce_time),
         "velocity": _vec(velocity),
         "collisions": False,
     }
     return body, ball
 
 
-def build_three_rods() -> dict[str, Any]:
-    """The three-rod scenario as YAML-ready data."""
+def build_three_rods(
+    specs: tuple[RodSpec, ...] = ROD_SPECS, name: str = "three_rods"
+) -> dict[str, Any]:
+    """The three-rod scenario as YAML-ready data (the paper's rods, or drawn ``specs``)."""
     bodies, props = [], []
-    for spec in ROD_SPECS:
+    for spec in specs:
         body, ball = _rod(spec)
         bodies.append(body)
         props.append(ball)
@@ -251,7 +261,7 @@ def build_three_rods() -> dict[str, Any]:
         }
     )
     return {
-        "name": "three_rods",
+        "name": name,
         "control_frequency": 60,
         "margin": 0.5,
         "workspace": {"low": [-12.0, -10.0, -1.0], "high": [12.0, 10.0, 12.0]},

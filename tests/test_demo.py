@@ -10,12 +10,14 @@ import pytest
 import yaml
 
 import sgc_env
-from baselines.cli.demo import DemoOptions
+from baselines.cli.demo import DemoOptions, DemoScene, gif_durations
+from baselines.cli.demo_camera import DEMO_SHOTS, camera_at
 from baselines.cli.main import main
 from baselines.evaluation import run_episode
 from baselines.expert import SGCExpert
 from sgc_env import three_rods
 from sgc_env.paper.frames import normalized_frame
+from sgc_env.simulator import pybullet
 
 MIN_SPEED_FRACTION = 0.1
 """A rod 'never stops': its tip speed stays above this fraction of its mean flight speed."""
@@ -136,9 +138,70 @@ def test_demo_command_writes_every_output(tmp_path, capsys):
     rods = json.loads((out / "rods.json").read_text())
     assert [r["goals"] for r in rods] == [25, 16, 17]
     assert all(r["position_error_max_m"] <= 1e-9 for r in rods)
-    assert "58/58 goals met" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "58/58 goals met" in printed and "CPU" in printed and "tangent rule" in printed
+
+
+def test_demo_can_show_the_papers_rule(tmp_path, capsys):
+    out = tmp_path / "paper"
+    assert main(["demo", "--out", str(out), "--no-video", "--paper-rule"]) == 0
+    printed = capsys.readouterr().out
+    assert "paper's k rules" in printed and "58/58 goals met" in printed
+    assert json.loads((out / "summary.json").read_text())["position_error_max"] <= 1e-9
+
+
+def test_gif_delays_add_up_to_real_time():
+    """GIF delays are whole centiseconds: 15 fps needs 70, 70, 60 ms, never all 60 or 70."""
+    durations = gif_durations(130, 15.0)
+    assert all(d % 10 == 0 for d in durations)
+    elapsed = np.cumsum(durations)
+    real = np.arange(1, 131) * 1000.0 / 15.0
+    assert np.max(np.abs(elapsed - real)) <= 5.0
+    assert set(durations) == {60, 70}
+
+
+def test_pierced_balls_ride_their_rods():
+    env = gym.make("SGCThreeRods-v0")
+    env.reset(seed=0)
+    base = env.unwrapped
+    scene = DemoScene(base.sim, base.scenario)
+    client = base.sim.client
+    before = three_rods.PIERCE_TIME - 0.5
+    scene.update(before)
+    for ball, uid in zip(scene.balls, scene.ball_uids, strict=True):
+        at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
+        np.testing.assert_allclose(at, ball.position_at(before), atol=1e-12)
+    scene.update(three_rods.PIERCE_TIME + 1.0)  # slid to the middle of the rod
+    for rod, uid in zip(scene.rods, scene.ball_uids, strict=True):
+        centre = pybullet.getBasePositionAndOrientation(rod, physicsClientId=client)[0]
+        at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
+        np.testing.assert_allclose(at, centre, atol=1e-12)
+    env.close()
+
+
+def test_cameras_look_where_the_shots_say():
+    for shot in DEMO_SHOTS:
+        view = camera_at(shot.time, 320, 180)
+        px, depth = view.project(np.array([shot.look_at]))
+        np.testing.assert_allclose(px[0], [160.0, 90.0], atol=1e-3)
+        assert depth[0] == pytest.approx(shot.distance, rel=1e-6)  # float32 matrices
 
 
 def test_demo_options_are_validated():
     with pytest.raises(ValueError, match="width"):
         DemoOptions(out=sgc_env.__path__[0], width=0)
+
+
+def test_target_board_whole_in_frame_once_the_flight_is_on():
+    """From 2.6 s (the wide shot) to the end, all 8 corners of the board project inside."""
+    from baselines.cli.demo import _box_corners
+
+    scenario = sgc_env.load_scenario("three_rods")
+    board = next(p for p in scenario.props if p.name == "target")
+    corners = _box_corners(board.position, board.size)
+    end = max(float(g.time) for b in scenario.bodies for g in b.goals) + scenario.margin
+    for t in np.arange(2.6, end, 1.0 / 30.0):
+        view = camera_at(float(t), 960, 540)
+        px, depth = view.project(corners)
+        assert np.all(depth > 0.0)
+        assert np.all((px >= 0.0) & (px <= [960.0, 540.0])), t

@@ -13,9 +13,16 @@ from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
-from sgc_env.envs import SGCEnv
+from sgc_env.envs import GoalEvent, SGCEnv, StepInfo
 from sgc_env.observation import BASE_BLOCK_SIZE, RESIDUAL_FIELDS, float32_residuals
-from sgc_env.scenario import Body, Goal, Scenario, load_scenario
+from sgc_env.scenario import (
+    Body,
+    Goal,
+    Scenario,
+    ScenarioError,
+    load_scenario,
+    resolve_scenario,
+)
 
 
 def rollout(env: gym.Env, seed: int, steps: int) -> list[np.ndarray]:
@@ -269,6 +276,9 @@ def test_goal_ticks_advance_goals_and_report_errors():
         steps += 1
         events += info.get("goal_reached", [])
         assert not terminated
+        assert set(info) - {"goal_reached"} == StepInfo.__required_keys__
+        assert set(info) - StepInfo.__required_keys__ <= StepInfo.__optional_keys__
+    assert all(set(e) == GoalEvent.__required_keys__ for e in events)
     assert steps == 90 + 15  # last goal at 1.5 s, margin 0.25 s, 60 Hz
     assert [e["goal"] for e in events] == [0, 1, 2]
     assert [round(e["time"] * 60) for e in events] == [30, 58, 90]
@@ -281,13 +291,14 @@ def test_goal_ticks_advance_goals_and_report_errors():
     np.testing.assert_allclose(end_v, expected, rtol=1e-6)
 
 
-def _somersault_env(time: float) -> SGCEnv:
+def _somersault_env(time: float, check_plan: bool = True) -> SGCEnv:
     body = Body(
         "rod", shape="rod", size=(0.6, 0.03), position=(0.0, 0.0, 1.0),
         angular_velocity=(2.0 * math.pi, 0.0, 0.0),
         goals=(Goal(relative_rotation=(2.0 * math.pi, 0.0, 0.0), time=time),),
     )  # fmt: skip
-    return SGCEnv(Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0))
+    scenario = Scenario(bodies=(body,), gravity=(0, 0, 0), margin=0.0)
+    return SGCEnv(resolve_scenario(scenario, check_plan=check_plan))
 
 
 def test_somersault_is_split_into_courses_tracked_continuously():
@@ -316,15 +327,21 @@ def test_somersault_is_split_into_courses_tracked_continuously():
 
 
 def test_somersault_without_enough_ticks_is_rejected():
-    with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
+    # The plan check splits the somersault on the env's ticks too, so it refuses it first.
+    with pytest.raises(ValueError, match=r"bodies\[0\]\.goals.*rotation of 6.28.*3 courses"):
         _somersault_env(2.0 / 60.0)
+    # Without the plan check the env's own course split still refuses it.
+    with pytest.raises(ValueError, match=r"rod.goals\[0\].*relative rotation of 6.28.*3 courses"):
+        _somersault_env(2.0 / 60.0, check_plan=False)
 
 
 def test_workspace_exit_terminates():
     body = Body("b", position=(0.0, 0.0, 0.0), linear_velocity=(30.0, 0.0, 0.0),
                 goals=(Goal(nail=(0.5, 0.0, 0.0), time=1.0),))  # fmt: skip
     s = Scenario(bodies=(body,), gravity=(0, 0, 0), workspace=((-1, -1, -1), (1, 1, 1)))
-    env = SGCEnv(s)
+    with pytest.raises(ScenarioError, match="force of 11"):  # the plan check sees it coming
+        resolve_scenario(s)
+    env = SGCEnv(resolve_scenario(s, check_plan=False))
     env.reset()
     for _ in range(10):
         _, _, terminated, truncated, _ = env.step(np.zeros(3, np.float32))
@@ -391,6 +408,19 @@ def test_goal_env_with_her():
         policy_kwargs={"net_arch": [16]}, seed=0,
     )  # fmt: skip
     model.learn(330)
+    # HER relabels desired goals with achieved ones; every relabelled reward must be the env's
+    # own compute_reward(next achieved, desired), and relabelling must create successes.
+    batch = model.replay_buffer.sample(2000)
+    achieved = batch.next_observations["achieved_goal"].numpy()
+    desired = batch.observations["desired_goal"].numpy()
+    expected = env.unwrapped.compute_reward(achieved, desired, [{}] * len(desired))
+    rewards = batch.rewards.numpy().ravel()
+    # A failure's transition also carries the charge for the steps it left (its stored info's
+    # failure_charge, which the empty infos here do not have); those are terminal.
+    charged = rewards < -1.0
+    np.testing.assert_array_equal(rewards[~charged], expected[~charged])
+    assert (batch.dones.numpy().ravel()[charged] == 1.0).all()
+    assert model.num_timesteps == 330 and (rewards == 0.0).any() and (rewards == -1.0).any()
 
 
 def test_close_disconnects():
@@ -401,7 +431,7 @@ def test_close_disconnects():
 
 
 def test_spin_clamp_is_flagged_not_terminal():
-    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 99.5), shape="rod"))
+    env = SGCEnv(coasting_scenario(velocity=(0.0, 0.0, 0.0), angular=(0, 0, 98.9), shape="rod"))
     env.reset()
     _, _, terminated, _, info = env.step(np.array([0, 0, 0, 0, 0, 1], np.float32))
     assert info["spin_clamped"] and not terminated
@@ -422,3 +452,56 @@ def test_goals_of_every_body_are_reported_when_another_body_is_done():
             (e["body"], e["goal"], round(e["time"] * 60)) for e in info.get("goal_reached", [])
         ]
     assert events == [(1, 0, 15), (0, 0, 30), (1, 1, 60)]
+
+
+def test_one_env_id_check_names_the_field_and_the_ids():
+    assert sgc_env.check_env_id("SGCPoint-v0") == "SGCPoint-v0"
+    with pytest.raises(ValueError, match=r"^env: unknown environment 'Nope-v0'; SGC ids: \['SGCP"):
+        sgc_env.check_env_id("Nope-v0", "env")
+    with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
+        sgc_env.check_env_id(3)
+
+
+def test_dense_reward_is_its_documented_formula():
+    """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
+    current course's start deviations, floored at 0.1 m and 0.5 rad): the "distance" mode."""
+    env = gym.make("SGCRod-v0", reward="distance")
+    obs, _ = env.reset(seed=3)
+    lay = env.unwrapped.layout
+    rng = np.random.default_rng(0)
+    bonus_ticks = 0
+    for _ in range(150):
+        a = rng.uniform(-1, 1, env.action_space.shape).astype(np.float32)
+        obs, reward, terminated, truncated, info = env.step(a)
+        scale_l = max(np.linalg.norm(obs[lay.body_slice(0, "position_course_start")]), 0.1)
+        scale_a = max(np.linalg.norm(obs[lay.body_slice(0, "orientation_course_start")]), 0.5)
+        expected = -(
+            np.linalg.norm(info["position_deviation"][0]) / scale_l
+            + np.linalg.norm(info["orientation_deviation"][0]) / scale_a
+        ) - 0.01 * np.mean(a.astype(np.float64) ** 2)
+        for ev in info.get("goal_reached", []):
+            bonus_ticks += 1
+            if ev["position_error"] is not None:
+                expected += math.exp(-ev["position_error"] / 0.01)
+            if ev["orientation_error"] is not None:
+                expected += math.exp(-ev["orientation_error"] / 0.02)
+        assert reward == pytest.approx(expected, rel=1e-5, abs=1e-9)
+        if terminated or truncated:
+            break
+    assert bonus_ticks > 0
+    env.close()
+
+
+def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
+    from conftest import closing_every_env
+
+    with closing_every_env() as made:
+        left_open = gym.make("SGCPoint-v0")
+        closed = SGCEnv("point_three_goals")
+        closed.close()
+        client = left_open.unwrapped.sim.client
+        assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert made == [left_open.unwrapped, closed]
+    assert left_open.unwrapped._closed
+    assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
+    assert close_envs == made  # nested blocks: the autouse fixture saw them too

@@ -60,3 +60,11 @@ def test_the_detector_sees_a_lazy_upward_import(tmp_path):
     module = tmp_path / "lazy.py"
     module.write_text("def f():\n    from baselines.expert import SGCExpert\n    return 1\n")
     assert "baselines.expert" in _imported_modules(module)
+
+
+@pytest.mark.parametrize(
+    "path", _modules("sgc_env") + _modules("baselines"), ids=lambda p: str(p.relative_to(ROOT))
+)
+def test_every_module_opens_with_a_docstring(path):
+    doc = ast.get_docstring(ast.parse(path.read_text(), filename=str(path)))
+    assert doc and doc.strip(), f"{path.relative_to(ROOT)} has no module docstring"

@@ -11,12 +11,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import BSpline, PPoly
 from scipy.spatial.transform import Rotation
 
-from baselines.minimum_jerk import (
-    MinimumJerkPath,
-    MinimumJerkRotation,
-    left_jacobian,
-    unwrap_rotation_vector,
-)
+from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 
 TIMES = np.array([0.0, 0.7, 1.5, 2.0, 3.1])
 POINTS = np.random.default_rng(1).normal(size=(5, 3))
@@ -94,12 +89,6 @@ def test_angular_velocity_matches_finite_differences():
         assert np.allclose(numeric, path.angular_velocity(t), atol=1e-6)
     assert np.allclose(path.angular_velocity(0.0), [0.2, 0.0, 0.1], atol=1e-12)
     assert np.allclose(path.angular_velocity(2.0), [0.0, 0.3, 0.0], atol=1e-12)
-
-
-def test_unwrap_and_jacobian_helpers():
-    assert np.allclose(unwrap_rotation_vector([0, 0, -3.0], [0, 0, 3.0]), [0, 0, 2 * math.pi - 3])
-    assert np.allclose(unwrap_rotation_vector([0, 0, 0], [0, 0, 6.0]), [0, 0, 2 * math.pi])
-    assert np.allclose(left_jacobian(np.zeros(3)), np.eye(3))
 
 
 @pytest.mark.parametrize(

@@ -19,8 +19,8 @@ from sgc_env.paper.orientation import (
     orientation_deviation,
     quat_to_rotvec,
     rotvec_to_quat,
-    unwrap_rotvec,
 )
+from sgc_env.paper.quaternion import unwrap_rotvec
 
 vec = st.lists(st.floats(-1, 1), min_size=3, max_size=3).map(np.array)
 scales = st.sampled_from([1e-6, 1e-2, 0.04, 0.06, 0.5, 2.0, 3.0, 4.0, 9.0])
@@ -98,6 +98,9 @@ def test_unwrap_tracks_a_somersault_continuously():
 def test_unwrap_identity_and_same_rotation():
     prev = np.array([0.0, 0.0, 2 * math.pi + 0.01])
     np.testing.assert_allclose(unwrap_rotvec(np.zeros(3), prev), [0, 0, 2 * math.pi])
+    np.testing.assert_allclose(unwrap_rotvec([0, 0, 0], [0, 0, 6.0]), [0, 0, 2 * math.pi])
+    np.testing.assert_allclose(unwrap_rotvec([0, 0, -3.0], [0, 0, 3.0]), [0, 0, 2 * math.pi - 3])
+    assert unwrap_rotvec([0, 0, 0], [0, 0, 3.0]) == (0, 0, 0)
     phi = unwrap_rotvec(np.array([0.0, 0.0, 0.5]), np.array([0.0, 0.0, -5.0]))
     np.testing.assert_allclose(phi, [0, 0, 0.5 - 2 * math.pi])
     assert Rotation.from_rotvec(phi).approx_equal(Rotation.from_rotvec([0, 0, 0.5]))

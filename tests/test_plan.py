@@ -101,7 +101,7 @@ def test_end_velocity_between_averages_within_paper_assumption():
         nails = np.cumsum(rng.normal(size=(6, 3)) * 0.1 + np.array([1.0, 0.3, 0.0]), axis=0)
         times = np.cumsum(rng.uniform(0.4, 1.2, 6))
         goals = [PositionGoal(t, n) for t, n in zip(times, nails, strict=True)]
-        plan = plan_body(_state(), goals)
+        plan = plan_body(_state(), goals, options=PlanOptions(end_rule="paper"))
         starts = [np.array([0, 0, 1.0]) - nails[0]] + [nails[i] - nails[i + 1] for i in range(5)]
         durations = np.diff(np.concatenate(([0.0], times)))
         for c in plan.courses:
@@ -316,3 +316,48 @@ def test_random_rod_plans_are_exact_and_continuous(pos_spec, ori_spec, initial):
         scale = 1.0 + np.abs(a.acceleration).max() + np.abs(b.acceleration).max()
         np.testing.assert_allclose(b.position, a.position, atol=1e-6 * scale)
         np.testing.assert_allclose(b.velocity, a.velocity, atol=1e-5 * scale)
+
+
+def test_somersault_on_the_control_grid_splits_as_the_env_does():
+    """plan_body and the env's tracks share one splitter: on a control grid the sub-courses
+    end on the same ticks (2.05 s at 60 Hz is 123 ticks, not divisible into 5 courses)."""
+    from sgc_env.envs.tracks import compile_tracks
+    from sgc_env.scenario import Body, Goal, Scenario, resolve_scenario
+
+    rel = np.array([0.0, 3 * math.pi, 0.0])
+    goal = Goal(time=2.05, relative_rotation=tuple(rel))
+    body = Body(name="rod", shape="rod", size=(0.8, 0.02), mass=1.0, goals=(goal,))
+    tracks = compile_tracks(resolve_scenario(Scenario(bodies=(body,), control_frequency=60)))
+    plan = plan_body(
+        _state(), [], [OrientationGoal(2.05, relative_rotation=rel)],
+        options=PlanOptions(control_frequency=60),
+    )  # fmt: skip
+    ends = [c.t_end for c in plan.courses]
+    assert ends == tracks[0].orientation.times.tolist()
+    assert [round(t * 60) for t in ends] == [25, 49, 74, 98, 123]
+    even = plan_body(_state(), [], [OrientationGoal(2.05, relative_rotation=rel)])
+    assert [c.t_end for c in even.courses] != ends  # continuous time: 0.41, 0.82, ...
+
+
+def test_vectorised_deviations_match_the_samples():
+    """BodyPlan.deviations (one vectorised evaluation per course) agrees with sample()."""
+    plan, pos, _ = _rod_plan()
+    times = np.array([0.05, 0.7, 0.71, 1.5, 2.1, 2.9, 3.0, 3.4])
+    d, v, a = plan.deviations(times, "position")
+    nails = np.array([pos[min(np.searchsorted([g.time for g in pos], t), 3)].nail for t in times])
+    for k, t in enumerate(times):
+        s = plan.sample(float(t))
+        np.testing.assert_allclose(d[k] + nails[k], s.point_position, atol=1e-12)
+        np.testing.assert_allclose(v[k], s.point_velocity, atol=1e-12)
+    h = 1e-6  # D'' is the derivative of D' (inside courses)
+    for t in (0.3, 1.0, 2.5):
+        (v0, v1), acc = plan.deviations(np.array([t - h, t + h]))[1], plan.deviations([t])[2][0]
+        np.testing.assert_allclose((v1 - v0) / (2 * h), acc, atol=1e-4)
+    # at an orientation goal phi = 0, so J_l = I and omega = phi'
+    goal_times = np.array([1.0, 2.0, 3.0])
+    phi, phi_dot, _ = plan.deviations(goal_times, "orientation")
+    np.testing.assert_allclose(phi, 0.0, atol=1e-12)
+    for k, t in enumerate(goal_times):
+        np.testing.assert_allclose(phi_dot[k], plan.sample(float(t)).angular_velocity, atol=1e-12)
+    with pytest.raises(ValueError, match="track must be"):
+        plan.deviations(times, "spin")

@@ -9,6 +9,7 @@ import pytest
 import sgc_env  # noqa: F401  (registers the env ids)
 from baselines import DynamicConstraintsController, MinimumJerkController, SGCExpert
 from baselines.policies import (
+    BUILTIN_POLICIES,
     EpisodeExpert,
     NormalizedPolicy,
     RandomPolicy,
@@ -216,3 +217,31 @@ def test_algorithm_from_data_rejects_foreign_data():
         algorithm_from_data({})
     with pytest.raises(ValueError, match="cannot tell"):
         algorithm_from_data({"policy_class": _policy_class("my.policies")})
+
+
+def test_every_policy_kind_satisfies_the_policy_protocol():
+    """Runtime: isinstance on the Protocol; static shape: predict takes SB3's parameters by
+    name with SB3's defaults, and returns (action, state) with the action in the space."""
+    import inspect
+
+    from stable_baselines3 import PPO
+
+    from baselines.policies import Policy
+
+    env = gym.make("SGCPoint-v0")
+    obs, _ = env.reset(seed=0)
+    policies = {spec: make_policy(spec, env, seed=0) for spec in BUILTIN_POLICIES}
+    policies["SGCExpert"] = SGCExpert(env)
+    policies["PPO"] = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")
+    for name, policy in policies.items():
+        assert isinstance(policy, Policy), name
+        params = inspect.signature(policy.predict).parameters
+        assert list(params)[:4] == ["observation", "state", "episode_start", "deterministic"]
+        assert params["state"].default is None and params["episode_start"].default is None
+        assert isinstance(params["deterministic"].default, bool), name  # SB3's is False
+        action, _ = policy.predict(
+            obs, state=None, episode_start=np.array([True]), deterministic=True
+        )
+        assert env.action_space.contains(np.asarray(action, np.float32)), name
+    assert not isinstance(object(), Policy)
+    env.close()

@@ -97,7 +97,8 @@ def test_path_goals_times_follow_arc_length():
     arc = parametric_curve("arc", center=[0, 0, 1], radius=1.0, start_angle=0.0, end_angle=math.pi)
     goals = path_goals(arc, 6, time=1.2)
     body = Body("b", position=(1.0, 0.0, 1.0), goals=goals)
-    s = resolve_scenario(Scenario(bodies=(body,)))
+    # Only the timing matters here: the limits stay at their defaults, so saturation is allowed.
+    s = resolve_scenario(Scenario(bodies=(body,), allow_saturation=True))
     times = np.array([g.time for g in s.bodies[0].goals])
     np.testing.assert_allclose(np.diff(np.concatenate(([0], times))), 0.2, atol=1e-12)
 
@@ -110,6 +111,7 @@ def test_named_curves_from_yaml():
                       "height": 0.3, "start_angle": -1.5707963}, "samples": 4},
         )
     )  # fmt: skip
+    data["allow_saturation"] = True  # a full helix turn in 0.5 s needs more than 50 N
     s = load(data)
     assert len(s.bodies[0].goals) == 7
 
@@ -176,6 +178,8 @@ BAD_INPUTS = [
      "bodies[0].force_limit: 5.0 N cannot hold the body against gravity"),
     ("bad time grid", lambda d: d.update(time_grid="round"),
      "time_grid: expected one of ('reject', 'snap')"),
+    ("bad end rule", lambda d: d.update(end_velocity_rule="spline"),
+     "end_velocity_rule: expected one of ('tangent', 'paper'), got 'spline'"),
     ("no bodies", lambda d: d.update(bodies=[]),
      "bodies: expected a non-empty list of bodies"),
 ]  # fmt: skip

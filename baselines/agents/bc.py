@@ -12,7 +12,7 @@ distribution and the expert's feedback is what corrects that drift.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
@@ -38,7 +38,8 @@ def deterministic_actions(model: BaseAlgorithm, obs: th.Tensor) -> th.Tensor:
     """Differentiable deterministic action of the model's actor (before clipping)."""
     policy = model.policy
     if isinstance(policy, ActorCriticPolicy):
-        return policy.get_distribution(obs).distribution.mean
+        distribution: Any = policy.get_distribution(obs).distribution  # one Normal here
+        return distribution.mean
     actor = getattr(policy, "actor", None)
     if actor is None:
         raise ValueError(f"algo: cannot clone into {type(model).__name__}: no actor")
@@ -53,17 +54,18 @@ def actor_parameters(model: BaseAlgorithm) -> list[th.nn.Parameter]:
     policy = model.policy
     if isinstance(policy, ActorCriticPolicy):
         skip = {id(p) for p in policy.value_net.parameters()}
-        skip |= {id(p) for p in policy.mlp_extractor.value_net.parameters()}
+        value_net: Any = policy.mlp_extractor.value_net
+        skip |= {id(p) for p in value_net.parameters()}
         skip.add(id(policy.log_std))
         return [p for p in policy.parameters() if id(p) not in skip]
-    return list(policy.actor.parameters())
+    return list(cast(Any, policy).actor.parameters())
 
 
 def _sync_targets(model: BaseAlgorithm) -> None:
     """TD3 keeps a target actor; it must start from the clone too."""
     target = getattr(model, "actor_target", None)
     if target is not None:
-        target.load_state_dict(model.actor.state_dict())
+        target.load_state_dict(cast(Any, model).actor.state_dict())
 
 
 def behaviour_clone(

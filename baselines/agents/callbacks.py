@@ -18,6 +18,7 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 from baselines.policies import NormalizedPolicy
+from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
     "EVAL_SEED",
@@ -25,9 +26,6 @@ __all__ = [
     "HarnessEvalCallback",
     "score_key",
 ]
-
-EVAL_SEED = 10_000
-"""First held-out evaluation seed; training envs use the run seed and its successors."""
 
 
 def _scalar_items(summary: dict[str, Any], prefix: str = "") -> dict[str, float]:

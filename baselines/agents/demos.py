@@ -1,8 +1,8 @@
 """Expert demonstrations: seeded rollouts stored in one ``.npz`` file.
 
-Minari was checked and left out: its 0.5 recorder needs jax (``minari[create]``) and its HDF5
-storage needs an undeclared Pillow, which is a lot of weight for a table of arrays. The format
-here is flat and documented (docs/agents.md):
+This flat npz is what behaviour cloning and DAgger read; a Minari dataset of the same
+episodes is :mod:`baselines.agents.minari_data` (``sgc demos --format minari``). The format
+(docs/agents.md):
 
 | key | shape | meaning |
 |---|---|---|
@@ -31,6 +31,7 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.agents.pushes import Pushes, apply_random_push, push_rng
+from sgc_env import check_env_id
 
 __all__ = ["FORMAT_VERSION", "Demonstrations", "load_demos", "record_demos"]
 
@@ -136,9 +137,8 @@ def record_demos(
     ``pushes``, a pushed step records the observation after the push and the action taken on
     it, which for the expert is the recovery from the push.
     """
-    from baselines.agents.train import check_env_id
 
-    check_env_id(env_id)
+    check_env_id(env_id, "env")
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     env_kwargs = dict(env_kwargs or {})

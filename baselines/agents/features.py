@@ -23,6 +23,9 @@ SCALE_FLOOR = 0.05
 class StandardizeObservation(BaseFeaturesExtractor):
     """``(obs - mean) / scale`` with buffers (identity until :func:`set_statistics`)."""
 
+    mean: th.Tensor
+    scale: th.Tensor
+
     def __init__(self, observation_space: gym.spaces.Box) -> None:
         if not isinstance(observation_space, gym.spaces.Box) or len(observation_space.shape) != 1:
             raise ValueError(f"StandardizeObservation needs a flat Box, got {observation_space}")

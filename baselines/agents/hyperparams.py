@@ -16,16 +16,16 @@ from typing import Any
 
 import yaml
 
+from baselines.shipped import hyperparams_file
+
 __all__ = [
-    "DEFAULT_HYPERPARAMS_DIR",
+    "ALGORITHMS",
     "Hyperparams",
+    "algorithm_class",
     "linear_schedule",
     "load_hyperparams",
     "parse_kwargs_string",
 ]
-
-DEFAULT_HYPERPARAMS_DIR = Path(__file__).resolve().parents[2] / "hyperparams"
-"""``hyperparams/`` at the repository top (the package is installed editable)."""
 
 _ACTIVATIONS = ("ReLU", "Tanh", "ELU", "LeakyReLU", "SiLU", "GELU", "Sigmoid")
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
@@ -137,16 +137,23 @@ def _learning_rate(value: Any) -> Any:
     return float(value)
 
 
-def _algo_class(algo: str):
-    from baselines.agents.train import algorithm_class
+ALGORITHMS: tuple[str, ...] = ("ppo", "sac", "td3", "her")
 
-    return algorithm_class(algo)
+
+def algorithm_class(algo: str):
+    """SB3 class for ``algo`` (HER is SAC with a ``HerReplayBuffer``)."""
+    from stable_baselines3 import PPO, SAC, TD3
+
+    classes = {"ppo": PPO, "sac": SAC, "td3": TD3, "her": SAC}
+    if algo not in classes:
+        raise ValueError(f"algo: unknown algorithm {algo!r}; choose from {ALGORITHMS}")
+    return classes[algo]
 
 
 def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
-    """Read ``<directory>/<algo>.yml`` and resolve the entry for ``env_id``."""
-    algo_cls = _algo_class(algo)
-    path = Path(directory or DEFAULT_HYPERPARAMS_DIR) / f"{algo}.yml"
+    """Read ``<directory>/<algo>.yml`` (default: the packaged file) and resolve ``env_id``."""
+    algo_cls = algorithm_class(algo)
+    path = Path(directory) / f"{algo}.yml" if directory else hyperparams_file(algo)
     if not path.is_file():
         raise ValueError(f"algo: no hyperparameter file {path}")
     try:

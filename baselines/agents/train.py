@@ -3,7 +3,7 @@
 Everything that decides a run is written next to its model in ``config.json`` (resolved
 hyperparameters, seed, command), and every random source is seeded from ``seed``: SB3's
 ``set_random_seed``, the training envs (``seed + rank``), the model and the evaluation seeds
-(held out: :data:`~baselines.agents.callbacks.EVAL_SEED` onwards). On CPU the same seed and
+(held out: :data:`~sgc_env.defaults.EVAL_SEED` onwards). On CPU the same seed and
 command give the same parameters and the same scorecard.
 """
 
@@ -18,37 +18,19 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
+from sgc_env import check_env_id
+from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
     "ALGORITHMS",
     "TrainConfig",
     "TrainResult",
     "algorithm_class",
-    "check_env_id",
     "load_model",
     "train",
 ]
-
-ALGORITHMS: tuple[str, ...] = ("ppo", "sac", "td3", "her")
-
-
-def algorithm_class(algo: str):
-    """SB3 class for ``algo`` (HER is SAC with a ``HerReplayBuffer``)."""
-    from stable_baselines3 import PPO, SAC, TD3
-
-    classes = {"ppo": PPO, "sac": SAC, "td3": TD3, "her": SAC}
-    if algo not in classes:
-        raise ValueError(f"algo: unknown algorithm {algo!r}; choose from {ALGORITHMS}")
-    return classes[algo]
-
-
-def check_env_id(env_id: str) -> None:
-    """Raise a ValueError naming the known ids when ``env_id`` is not registered."""
-    import sgc_env
-
-    if env_id not in gym.registry:
-        raise ValueError(f"env: unknown env id {env_id!r}; registered: {sgc_env.ENV_IDS}")
 
 
 @dataclass
@@ -63,7 +45,7 @@ class TrainConfig:
     progress: bool = False
     eval_freq: int = 0
     eval_episodes: int = 10
-    eval_seed: int = 10_000
+    eval_seed: int = EVAL_SEED
     init: str = "none"
     demos: str | Path | None = None
     bc_epochs: int = 30
@@ -115,7 +97,7 @@ def _action_noise(hp, action_space: gym.spaces.Box):
 
 def _validate(cfg: TrainConfig) -> None:
     algorithm_class(cfg.algo)
-    check_env_id(cfg.env_id)
+    check_env_id(cfg.env_id, "env")
     if cfg.init not in ("none", "bc"):
         raise ValueError(f"init: expected 'none' or 'bc', got {cfg.init!r}")
     if cfg.init == "bc":
@@ -152,7 +134,7 @@ def _jsonable(value: Any) -> Any:
 def train(cfg: TrainConfig) -> TrainResult:
     """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
     import torch as th
-    from stable_baselines3.common.callbacks import CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -188,7 +170,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     bc_info = None
     if cfg.init == "bc":
         bc_info = _clone(model, cfg)
-    callbacks = []
+    callbacks: list[BaseCallback] = []
     if cfg.critic_warmup:
         callbacks.append(FreezeActorCallback(cfg.critic_warmup))
     if out is not None and cfg.checkpoint_freq:

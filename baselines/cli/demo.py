@@ -1,100 +1,139 @@
 """The paper's three-rod demo, run by the expert and written out as a viewer would want it.
 
-One episode of ``SGCThreeRods-v0`` driven by :class:`baselines.SGCExpert`, scored by the shared
-harness, and rendered headless (TinyRenderer) with a ground, a target board with a bullseye,
-and fading trails behind each rod's tip. Outputs: an MP4 and a GIF, an 8-frame plate sheet in
-the spirit of the paper's Plates 1-8, deviation plots per rod, ``goals.csv`` and
-``summary.json``.
+One episode of ``SGCThreeRods-v0`` driven by :class:`baselines.SGCExpert` (the tangent
+end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``), scored by
+the shared harness, and rendered headless: TinyRenderer for the bodies, then the look of
+:mod:`baselines.cli.demo_view` (sky, checkered floor, shadows, fading trails, nails) from the
+cameras of :mod:`baselines.cli.demo_camera`. Rods are drawn thicker than their physical
+radius, and each red ball, once pierced, rides on its rod into the target (visual only: the
+balls are kinematic props, physics is untouched). Outputs: an MP4 and a GIF at real time, an
+8-frame plate sheet in the spirit of the paper's Plates 1-8, deviation and speed plots per rod
+(named and coloured as in the video), ``goals.csv``, ``summary.json`` and ``rods.json``.
 """
 
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 
-from sgc_env.rendering import CameraConfig
+from baselines.cli.demo_camera import camera_at
+from baselines.cli.demo_view import TRAIL_SECONDS, Caster, DemoPainter, Trail
+from sgc_env.paper.end_rules import END_RULES
 from sgc_env.simulator import Simulator, pybullet
 
-__all__ = ["DEMO_CAMERA", "DemoOptions", "DemoResult", "TipTrails", "run_demo"]
+__all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
 
 ENV_ID = "SGCThreeRods-v0"
-DEMO_CAMERA = CameraConfig(
-    distance=12.5, yaw=0.0, pitch=-11.0, target=(-0.4, 0.0, 3.4), width=960, height=540, fov=52.0
-)
-GROUND_COLOR = (0.62, 0.68, 0.62, 1.0)
 PLATES = 8
+PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
+"""Moments the plates show: launch, piercing, flight, somersault, the hits, all three in."""
+ROD_DRAW_RADIUS = 0.075
+"""Drawn rod radius (m): the physical 0.04 m reads as a hair at video size."""
+BALL_SLIDE = 0.3
+"""Seconds a pierced ball takes to slide from the tip to the middle of its rod."""
+VIDEO_FPS = 30
 
 
 @dataclass(frozen=True)
 class DemoOptions:
-    """What to render: ``frame_every`` control ticks per video frame (60 Hz / 2 = 30 fps)."""
+    """What to run and render. ``end_rule``: the expert's end-velocity rule."""
 
     out: Path
-    width: int = DEMO_CAMERA.width
-    height: int = DEMO_CAMERA.height
-    frame_every: int = 2
+    width: int = 960
+    height: int = 540
     gif_scale: int = 2
-    trail_length: int = 90
     video: bool = True
+    end_rule: str = "tangent"
 
     def __post_init__(self) -> None:
-        for name in ("width", "height", "frame_every", "gif_scale", "trail_length"):
+        for name in ("width", "height", "gif_scale"):
             value = getattr(self, name)
             if not isinstance(value, int) or value < 1:
                 raise ValueError(f"{name}: expected a positive integer, got {value!r}")
+        if self.end_rule not in END_RULES:
+            raise ValueError(f"end_rule: expected one of {END_RULES}, got {self.end_rule!r}")
 
 
 @dataclass
 class DemoResult:
-    """Where everything went, and the scorecard."""
+    """Where everything went, the scorecard, and the CPU seconds the run took."""
 
     files: dict[str, Path] = field(default_factory=dict)
     summary: dict[str, Any] = field(default_factory=dict)
     per_rod: list[dict[str, Any]] = field(default_factory=list)
+    cpu_s: float = 0.0
 
 
-class TipTrails:
-    """Visual-only spheres left behind each tip: a ring buffer per rod (physics untouched)."""
+def cpu_seconds() -> float:
+    """CPU time of this process and its waited-for children (ffmpeg), user + system."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
 
-    def __init__(self, sim: Simulator, colors: Sequence[Sequence[float]], length: int) -> None:
+
+class DemoScene:
+    """The visual-only dressing: bullseye, thick rod shells, carried balls."""
+
+    def __init__(self, sim: Simulator, scenario: Any) -> None:
+        from sgc_env import three_rods
+
         self.sim = sim
-        self.length = length
-        self.markers = [
-            [sim.add_marker(0.05 * (0.3 + 0.7 * k / length), _faded(c, k / length))
-             for k in range(length)]
-            for c in colors
-        ]  # fmt: skip
-        self.history: list[list[tuple[float, float, float]]] = [[] for _ in colors]
+        client = sim.client
+        props = {p.name: p for p in scenario.props}
+        self.target = props["target"]
+        _bullseye(client, self.target.position, self.target.size)
+        self.rods = [sim.bodies[b.name].uid for b in scenario.bodies]
+        self.shells = []
+        for body in scenario.bodies:
+            shape = pybullet.createVisualShape(
+                pybullet.GEOM_CYLINDER, radius=ROD_DRAW_RADIUS, length=float(body.size[0]),
+                rgbaColor=list(body.color), physicsClientId=client,
+            )  # fmt: skip
+            self.shells.append(pybullet.createMultiBody(0.0, -1, shape, [0, 0, -1e3],
+                                                        physicsClientId=client))  # fmt: skip
+        self.balls = [props[f"ball_{b.name[4:]}"] for b in scenario.bodies]
+        self.ball_uids = [sim.bodies[p.name].uid for p in self.balls]
+        self.tip = np.asarray(three_rods.TIP, float)
+        self.pierce_time = three_rods.PIERCE_TIME
 
-    def update(self, tips: np.ndarray) -> None:
-        for rod, tip in enumerate(np.asarray(tips, dtype=float)):
-            trail = self.history[rod]
-            trail.append(tuple(tip))
-            del trail[: -self.length]
-            for marker, position in zip(self.markers[rod][-len(trail):], trail, strict=True):
-                self.sim.move(marker, position)
+    def update(self, now: float) -> list[Caster]:
+        """Place shells and balls for time ``now``; the shadow casters of the scene."""
+        client = self.sim.client
+        casters = [Caster(corners=_box_corners(self.target.position, self.target.size))]
+        for rod, shell, ball, ball_uid in zip(self.rods, self.shells, self.balls, self.ball_uids,
+                                              strict=True):  # fmt: skip
+            position, orientation = pybullet.getBasePositionAndOrientation(
+                rod, physicsClientId=client
+            )
+            self.sim.move(shell, position, orientation)
+            axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+            centre = np.asarray(position)
+            casters.append(Caster(centre - axis @ self.tip, centre + axis @ self.tip,
+                                  ROD_DRAW_RADIUS))  # fmt: skip
+            if now >= self.pierce_time:
+                slide = min((now - self.pierce_time) / BALL_SLIDE, 1.0)
+                along = self.tip * (1.0 - slide * slide * (3.0 - 2.0 * slide))
+                ball_at = centre + axis @ along
+            else:
+                ball_at = np.asarray(ball.position_at(now))
+            self.sim.move(ball_uid, ball_at)
+            casters.append(Caster(ball_at, None, float(ball.size[0])))
+        return casters
 
 
-def _faded(color: Sequence[float], age: float) -> tuple[float, float, float, float]:
-    """Blend towards white for older trail points."""
-    r, g, b = (float(c) for c in color[:3])
-    mix = 0.25 + 0.75 * age
-    return (1 - mix + mix * r, 1 - mix + mix * g, 1 - mix + mix * b, 1.0)
+def _box_corners(centre: Sequence[float], half: Sequence[float]) -> np.ndarray:
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
+    return np.asarray(centre, float) + signs * np.asarray(half, float)
 
 
-def dress_scene(sim: Simulator, target_center: Sequence[float], board_half: Sequence[float]):
-    """A ground and a bullseye on the target board (visual only)."""
-    client = sim.client
-    ground = pybullet.createVisualShape(
-        pybullet.GEOM_BOX, halfExtents=[30.0, 30.0, 0.02], rgbaColor=list(GROUND_COLOR),
-        physicsClientId=client,
-    )  # fmt: skip
-    pybullet.createMultiBody(0.0, -1, ground, [0.0, 0.0, -0.02], physicsClientId=client)
+def _bullseye(client: int, target_center: Sequence[float], board_half: Sequence[float]) -> None:
+    """Rings on the target board's face (visual only)."""
     face_x = target_center[0] - board_half[0] - 0.005
     rings = ((1.6, (0.85, 0.1, 0.1, 1.0)), (1.1, (0.95, 0.95, 0.95, 1.0)),
              (0.6, (0.85, 0.1, 0.1, 1.0)), (0.2, (0.95, 0.85, 0.2, 1.0)))  # fmt: skip
@@ -123,42 +162,62 @@ def run_demo(
     )
     from baselines.expert import SGCExpert
 
+    started = cpu_seconds()
     options.out.mkdir(parents=True, exist_ok=True)
-    camera = {**asdict(DEMO_CAMERA), "width": options.width, "height": options.height}
-    env = gym.make(ENV_ID, render_mode="rgb_array", camera=camera)
+    env = gym.make(ENV_ID)
     base = env.unwrapped
-    target = next(p for p in base.scenario.props if p.name == "target")
-    dress_scene(base.sim, target.position, target.size)
-    trails = TipTrails(base.sim, [b.color for b in base.scenario.bodies], options.trail_length)
+    scenario = base.scenario
     total = base.max_steps
+    frame_every = round(base.control_frequency / VIDEO_FPS)
     frames: list[np.ndarray] = []
     frame_times: list[float] = []
+    tips: list[np.ndarray] = []
+    tip_times: list[float] = []
+    scene = painter = None
+    if options.video:
+        scene = DemoScene(base.sim, scenario)
+        nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
+        painter = DemoPainter(base.sim.client, [b.color for b in scenario.bodies], nails)
 
     def on_step(env_: Any, step: int, info: dict[str, Any]) -> None:
-        trails.update(info["point_position"])
-        if options.video and step % options.frame_every == 0:
-            frames.append(env_.render())
-            frame_times.append(float(info.get("time", 0.0)))
+        now = float(info.get("time", 0.0))
+        tips.append(np.asarray(info["point_position"], float))
+        tip_times.append(now)
+        if painter is not None and step % frame_every == 0:
+            casters = scene.update(now)
+            view = camera_at(now, options.width, options.height)
+            frames.append(painter.frame(view, _trails(tips, tip_times, now), casters, now))
+            frame_times.append(now)
         if progress is not None:
             progress(step, total)
 
-    expert = SGCExpert(env)
+    expert = SGCExpert(env, end_rule=options.end_rule)
     record = run_episode(expert, env, seed=0, keep_infos=True, on_step=on_step)
     env.close()
 
     result = DemoResult()
-    rows = goal_rows(record, ENV_ID, "expert")
+    label = "expert" if options.end_rule == "tangent" else "expert-paper"
+    rows = goal_rows(record, ENV_ID, label)
     result.summary = summarize([record], rows)
     result.files["goals.csv"] = write_goals_csv(rows, options.out / "goals.csv")
     result.files["summary.json"] = write_summary_json(result.summary, options.out / "summary.json")
-    result.per_rod = _per_rod(record, rows, base.scenario)
+    result.per_rod = _per_rod(record, rows, scenario)
     per_rod_path = options.out / "rods.json"
     per_rod_path.write_text(json.dumps(result.per_rod, indent=2))
     result.files["rods.json"] = per_rod_path
-    result.files.update(_plots(record, options.out))
-    if options.video and frames:
+    result.files.update(_plots(record, scenario, options.out))
+    if frames:
         result.files.update(_videos(frames, frame_times, options))
+    result.cpu_s = cpu_seconds() - started
     return result
+
+
+def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trail]:
+    """The last ``TRAIL_SECONDS`` of every tip, one sample per control tick."""
+    first = int(np.searchsorted(times, now - TRAIL_SECONDS))
+    recent = np.stack(tips[first:])
+    stamps = np.asarray(times[first:])
+    return [Trail(recent[:, b], stamps) for b in range(recent.shape[1])]
 
 
 def _per_rod(record: Any, rows: Sequence[dict[str, Any]], scenario: Any) -> list[dict[str, Any]]:
@@ -187,36 +246,71 @@ def _per_rod(record: Any, rows: Sequence[dict[str, Any]], scenario: Any) -> list
     return out
 
 
-def _plots(record: Any, out: Path) -> dict[str, Path]:
+def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
     from baselines.cli.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
 
     traj = trajectory_arrays(record.infos, record.initial_info)
+    bodies = {"names": [b.name for b in scenario.bodies],
+              "colors": [tuple(b.color[:3]) for b in scenario.bodies], "layout": None}  # fmt: skip
     return {
         "deviation.png": plot_deviation_components(
             traj, record.goals, out / "deviation.png",
             title="three rods: deviation of each tip (D) and orientation (phi), goal times dotted",
+            **bodies,
         ),
-        "speed.png": plot_speed_profile(traj, record.goals, out / "speed.png"),
+        "speed.png": plot_speed_profile(traj, record.goals, out / "speed.png", **bodies),
     }  # fmt: skip
+
+
+def gif_durations(count: int, fps: float) -> list[int]:
+    """Per-frame GIF delays (ms) summing to real time: GIF delays are whole centiseconds, so
+    a 1000/fps delay that is not one is spread (66.7 ms -> 70, 70, 60)."""
+    ends = np.round(np.arange(1, count + 1) * 100.0 / fps).astype(int) * 10
+    return np.diff(np.r_[0, ends]).tolist()
 
 
 def _videos(frames: list[np.ndarray], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
-    from matplotlib.figure import Figure
 
-    fps = 60 / options.frame_every
     mp4 = options.out / "three_rods.mp4"
-    imageio.mimwrite(mp4, frames, fps=fps, codec="libx264", quality=7, macro_block_size=4)
+    imageio.mimwrite(mp4, frames, fps=VIDEO_FPS, codec="libx264", quality=7, macro_block_size=4,
+                     ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
     gif = options.out / "three_rods.gif"
-    small = [f[:: options.gif_scale, :: options.gif_scale] for f in frames[::2]]
-    imageio.mimwrite(gif, small, duration=1000 * 2 / fps, loop=0)
-    picks = np.linspace(0, len(frames) - 1, PLATES).round().astype(int)
-    fig = Figure(figsize=(16, 5.2), layout="constrained")
-    axes = fig.subplots(2, PLATES // 2)
-    for k, (ax, i) in enumerate(zip(axes.ravel(), picks, strict=True)):
-        ax.imshow(frames[i])
-        ax.set_title(f"Plate {k + 1}  (t = {times[i]:.2f} s)", fontsize=10)
-        ax.axis("off")
+    step = options.gif_scale
+    small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)
+             for f in frames[::2]]  # fmt: skip
+    _write_gif(gif, small, gif_durations(len(small), VIDEO_FPS / 2))
     plates = options.out / "plates.png"
-    fig.savefig(plates, dpi=100)
+    imageio.imwrite(plates, plate_sheet(frames, times))
     return {"three_rods.mp4": mp4, "three_rods.gif": gif, "plates.png": plates}
+
+
+def _write_gif(path: Path, frames: Sequence[np.ndarray], durations: Sequence[int]) -> None:
+    """Pillow GIF with a fast octree palette per frame (median cut costs ~3x the CPU)."""
+    from PIL import Image
+
+    images = [
+        Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
+                                    dither=Image.Dither.FLOYDSTEINBERG)
+        for f in frames
+    ]  # fmt: skip
+    images[0].save(path, save_all=True, append_images=images[1:], duration=list(durations),
+                   loop=0, optimize=False)  # fmt: skip
+
+
+def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:
+    """Eight frames nearest :data:`PLATE_TIMES`, two rows of four, each titled."""
+    h, w = frames[0].shape[:2]
+    scale = min(1.0, 480.0 / w)
+    tw, th, band = int(w * scale), int(h * scale), 26
+    sheet = np.full((2 * (th + band), 4 * tw, 3), 255, np.uint8)
+    for k, want in enumerate(PLATE_TIMES):
+        i = int(np.argmin(np.abs(np.asarray(times) - want)))
+        row, col = divmod(k, 4)
+        y, x = row * (th + band), col * tw
+        sheet[y + band : y + band + th, x : x + tw] = cv2.resize(
+            frames[i], (tw, th), interpolation=cv2.INTER_AREA
+        )
+        cv2.putText(sheet, f"Plate {k + 1}   t = {times[i]:.2f} s", (x + 8, y + 18),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.5, (30, 30, 30), 1, cv2.LINE_AA)  # fmt: skip
+    return sheet

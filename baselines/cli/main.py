@@ -8,7 +8,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import sys
 from collections.abc import Sequence
+
+from baselines.cli.checks import UsageError
+from baselines.cli.console import DefaultsHelpFormatter
 
 __all__ = ["COMMANDS", "build_parser", "main"]
 
@@ -18,6 +22,7 @@ COMMANDS: dict[str, str] = {
     "demos": "record seeded expert demonstrations to an npz file",
     "evaluate": "score policies on envs with the shared harness: tables, CSV, JSON, plots",
     "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
+    "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
 }
 
 
@@ -28,15 +33,26 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_text in COMMANDS.items():
         module = importlib.import_module(f"baselines.cli.commands.{name.replace('-', '_')}")
-        command_parser = sub.add_parser(name, help=help_text, description=help_text)
+        command_parser = sub.add_parser(
+            name, help=help_text, description=help_text, formatter_class=DefaultsHelpFormatter
+        )
         module.add_arguments(command_parser)
         command_parser.set_defaults(_module=module)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return int(args._module.run(args) or 0)
+    words = list(sys.argv[1:] if argv is None else argv)
+    try:
+        args = build_parser().parse_args(words)
+    except SystemExit as exc:  # argparse: --help (0), or a bad argument reported in one line (2)
+        return int(exc.code or 0)
+    args.argv = words  # for commands that record how they were called
+    try:
+        return int(args._module.run(args) or 0)
+    except UsageError as exc:  # a bad argument found before any work; real bugs still raise
+        print(f"sgc {args.command}: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -26,15 +26,16 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv
+from sgc_env.defaults import POSITION_TOLERANCE
+from sgc_env.envs.sgc_env import OBS_BOUND, SGCEnv, StepInfo
 
-__all__ = ["SGCGoalEnv"]
+__all__ = ["GoalRewardAccess", "SGCGoalEnv"]
 
 
 class SGCGoalEnv(SGCEnv):
     """:class:`SGCEnv` with a Dict observation (observation, achieved_goal, desired_goal)."""
 
-    def __init__(self, *args: Any, tolerance: float = 0.02, **kwargs: Any) -> None:
+    def __init__(self, *args: Any, tolerance: float = POSITION_TOLERANCE, **kwargs: Any) -> None:
         if kwargs.get("reward") is not None:
             raise ValueError(
                 "reward: the goal-conditioned env's reward is its sparse goal reward "
@@ -63,16 +64,16 @@ class SGCGoalEnv(SGCEnv):
             "desired_goal": self.task.desired_goal(0),
         }
 
-    def reset(
+    def reset(  # type: ignore[override]  # a Dict observation where SGCEnv has a Box
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    ) -> tuple[dict[str, np.ndarray], StepInfo]:
         _, info = super().reset(seed=seed, options=options)
         self._last = self._dict_obs()
         return self._last, info
 
-    def step(
+    def step(  # type: ignore[override]  # a Dict observation where SGCEnv has a Box
         self, action: np.ndarray
-    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, StepInfo]:
         desired = self._last["desired_goal"]
         _, _, terminated, truncated, info = super().step(action)
         if terminated:
@@ -108,3 +109,22 @@ class SGCGoalEnv(SGCEnv):
                        for i in np.asarray(info, dtype=object).reshape(-1)]  # fmt: skip
             reward = reward - np.reshape(charges, reward.shape)
         return reward.astype(np.float32)
+
+
+class GoalRewardAccess(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Outermost wrapper of the registered goal id: exposes ``compute_reward``.
+
+    Gymnasium's wrappers (``TimeLimit``, ``OrderEnforcing``) do not forward attributes, and
+    SB3's ``check_env`` (like other GoalEnv tools) calls ``env.compute_reward`` on the env it
+    is given. The registry adds this wrapper after ``TimeLimit``.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.Wrapper.__init__(self, env)
+
+    def compute_reward(
+        self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any
+    ) -> np.ndarray:
+        """The base env's :meth:`SGCGoalEnv.compute_reward`."""
+        return self.env.unwrapped.compute_reward(achieved_goal, desired_goal, info)  # type: ignore[attr-defined]

@@ -112,10 +112,12 @@ def distance_cost(track: TrackState, floor: float) -> float:
 
 def tracks_of(task: GoalTask) -> list[tuple[TrackState, float]]:
     """Every track of every body with the floor of its scale (m for position, rad)."""
-    out = []
+    out: list[tuple[TrackState, float]] = []
     for i in range(task.n_bodies):
         if task.has_position[i]:
-            track = (task.deviations[i], task.position_time_left[i], task.position_course[i])
+            track: TrackState = (
+                task.deviations[i], task.position_time_left[i], task.position_course[i]
+            )
             out.append((track, POSITION_FLOOR))
         if task.has_orientation[i]:
             track = (task.phi[i], task.orientation_time_left[i], task.orientation_course[i])

@@ -88,15 +88,15 @@ Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_g
 (index into the body's goal list, -1 without a track), ``position_deviation``,
 ``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
 ``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
-``{body, goal, time, position_error, orientation_error}`` (norms of D and phi at that tick;
-None for a missing part).
+``{body, goal, time, position_error, orientation_error}`` (|D| and the angle between body and
+goal orientation, in [0, pi], at that tick; None for a missing part).
 
 ## Arguments
 
-``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name or
-:class:`~sgc_env.random_scenarios.RandomScenarioConfig`, redrawn from ``np_random`` on every
-reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency`` (240 Hz,
-an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
+``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
+``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
+(240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
 distance, yaw, pitch, target, width, height), ``reward`` (``"schedule"``, ``"distance"`` or
 ``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
@@ -108,26 +108,29 @@ from __future__ import annotations
 
 import math
 import struct
+import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict, cast
 
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.paper.quaternion import rotate, rotate_back
-from sgc_env.random_scenarios import PRESETS, RandomScenarioConfig
+from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.simulator import Drive, Simulator
 
+from .props import PropPaths
 from .rewards import make_reward
 from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
 
-__all__ = ["SGCEnv", "SavedState"]
+__all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
@@ -147,12 +150,74 @@ _COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
 _COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
 
 
+class _StepInfoEveryStep(TypedDict):
+    time: float
+    goal_index: np.ndarray
+    orientation_goal_index: np.ndarray
+    position_deviation: np.ndarray
+    orientation_deviation: np.ndarray
+    time_to_goal: np.ndarray
+    orientation_time_to_goal: np.ndarray
+    body_position: np.ndarray
+    body_orientation: np.ndarray
+    body_velocity: np.ndarray
+    body_angular_velocity: np.ndarray
+    point_position: np.ndarray
+    point_velocity: np.ndarray
+    force: np.ndarray
+    torque: np.ndarray
+    spin_clamped: bool
+
+
+class StepInfo(_StepInfoEveryStep, total=False):
+    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
+    one row per body; ``goal_reached`` only on a tick where goals fall."""
+
+    goal_reached: list[GoalEvent]
+    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    """A scenario checked against an env, with what it compiles to (see SGCEnv._prepare)."""
+
+    scenario: Scenario
+    task: GoalTask
+    max_steps: int
+    props: PropPaths
+
+
 @dataclass(frozen=True)
 class SavedState:
     """A snapshot from :meth:`SGCEnv.save_state`: the PyBullet state id plus env counters."""
 
     bullet_state: int
     counters: dict[str, Any]
+
+    def free(self) -> None:
+        """Free the PyBullet copy now instead of when this object is garbage-collected."""
+        release = getattr(self, "_release", None)
+        if release is not None:
+            release()
+
+    @property
+    def alive(self) -> bool:
+        """False once freed (explicitly or because its env closed)."""
+        release = getattr(self, "_release", None)
+        if release is None:
+            return True
+        details = release.peek()
+        return details is not None and _sim_open(details[2][0])
+
+
+def _sim_open(sim_ref: weakref.ref[Simulator]) -> bool:
+    sim = sim_ref()
+    return sim is not None and sim.client >= 0
+
+
+def _remove_state(sim_ref: weakref.ref[Simulator], state_id: int) -> None:
+    if _sim_open(sim_ref):
+        sim_ref().remove_state(state_id)  # type: ignore[union-attr]
 
 
 def _as_scenario(spec: Scenario | str | Path) -> Scenario:
@@ -175,7 +240,7 @@ class SGCEnv(gym.Env):
         self,
         scenario: Scenario | str | Path | None = None,
         *,
-        random_scenario: RandomScenarioConfig | str | None = None,
+        random_scenario: SceneFamily | str | None = None,
         control_frequency: int | None = None,
         sim_frequency: int = 240,
         time_grid: str | None = None,
@@ -183,7 +248,7 @@ class SGCEnv(gym.Env):
         camera: dict[str, Any] | None = None,
         reward: str = "schedule",
     ) -> None:
-        self._init_kwargs = {
+        self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
@@ -199,13 +264,15 @@ class SGCEnv(gym.Env):
             )
         self.render_mode = render_mode
         self.camera = CameraConfig.from_dict(camera)
-        self._random_config: RandomScenarioConfig | None = None
+        self._random_config: SceneFamily | None = None
         if scenario is None:
-            cfg = PRESETS[random_scenario] if isinstance(random_scenario, str) else random_scenario
+            cfg = (
+                PRESETS[random_scenario]
+                if isinstance(random_scenario, str)
+                else cast(SceneFamily, random_scenario)  # not None: checked above
+            )
             if control_frequency is not None:
-                cfg = RandomScenarioConfig(
-                    **{**cfg.__dict__, "control_frequency": control_frequency}
-                )
+                cfg = replace(cfg, control_frequency=control_frequency)
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
@@ -246,13 +313,21 @@ class SGCEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
-        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
         self._markers: NailMarkers | None = None
+        self._closed = False
         self.scenario: Scenario = base
         self._geometry: tuple = ()
-        self._build(base)
-        self._set_scenario(base)
-        self._reset_state()
+        # Everything that can reject the scenario runs before the PyBullet client exists; if
+        # building the scene still fails, the client is closed before the error propagates.
+        prepared = self._prepare(base)
+        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        try:
+            self._build(base)
+            self._commit(prepared)
+            self._reset_state()
+        except BaseException:
+            self.sim.close()
+            raise
 
     # ---------------------------------------------------------------- scenario handling
 
@@ -285,6 +360,12 @@ class SGCEnv(gym.Env):
             self._markers.clear()
 
     def _set_scenario(self, s: Scenario) -> None:
+        """Switch to ``s`` all at once: everything is checked and compiled before the env
+        changes, so a rejected scenario leaves the env exactly as it was."""
+        self._commit(self._prepare(s))
+
+    def _prepare(self, s: Scenario) -> _Prepared:
+        """Check ``s`` against this env and compile its tracks; changes nothing."""
         if len(s.bodies) != self._n:
             raise ValueError(
                 f"scenario has {len(s.bodies)} bodies, this env was made for {self._n}"
@@ -297,12 +378,27 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
+        max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
+        props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
+        return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
+
+    def _commit(self, prepared: _Prepared) -> None:
+        """Make a prepared scenario current. Rebuilding bodies is the one step that talks to
+        PyBullet; if it fails, the previous scene is rebuilt before the error propagates."""
+        s = prepared.scenario
         if _geometry(s) != self._geometry:
-            self._build(s)
+            previous = self.scenario
+            try:
+                self._build(s)
+            except BaseException:
+                self._build(previous)
+                raise
         self.scenario = s
         self.sim.set_gravity(s.gravity)
         self._gravity = tuple(float(g) for g in s.gravity)
-        self.task = GoalTask(s, self._reward)
+        self.task = prepared.task
+        self.max_steps = prepared.max_steps
+        self._props = prepared.props
         self._mass = [b.mass for b in s.bodies]
         self._flimit = [float(b.force_limit) for b in s.bodies]
         self.torque_scale = np.array(
@@ -314,41 +410,23 @@ class SGCEnv(gym.Env):
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
-        last_tick = max(
-            round(float(g.time) * self.control_frequency) for b in s.bodies for g in b.goals
-        )
-        self.max_steps = last_tick + math.ceil(s.margin * self.control_frequency - 1e-9)
-        self._prop_table = self._prop_positions(s)
         if self._markers is not None:
             self._markers.place(s)
 
-    def _prop_positions(self, s: Scenario) -> list[list[tuple[float, float, float]]]:
-        """Kinematic prop positions at every substep time of the episode (computed once)."""
-        if not s.props:
-            return []
-        n_sub = (self.max_steps + 1) * self.substeps + 1
-        t = np.arange(n_sub) / self.sim_frequency
-        table = []
-        for p in s.props:
-            if p.waypoints:
-                times = [w[0] for w in p.waypoints]
-                pts = np.asarray([w[1] for w in p.waypoints])
-                xyz = np.stack([np.interp(t, times, pts[:, j]) for j in range(3)], axis=1)
-            else:
-                xyz = np.asarray(p.position) + np.outer(t, p.velocity)
-            table.append(xyz)
-        arr = np.stack(table, axis=1)
-        return [[tuple(map(float, row)) for row in step] for step in arr]
-
     # ---------------------------------------------------------------- reset / step
 
-    def reset(
+    def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
+    ) -> tuple[np.ndarray, StepInfo]:
+        self._check_open()
         options = options or {}
+        prepared = None
         if options.get("scenario") is not None:
-            self._set_scenario(self._resolve(_as_scenario(options["scenario"])))
+            # Checked and compiled before the seed or anything else changes (transactional).
+            prepared = self._prepare(self._resolve(_as_scenario(options["scenario"])))
+        super().reset(seed=seed)
+        if prepared is not None:
+            self._commit(prepared)
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
@@ -363,7 +441,7 @@ class SGCEnv(gym.Env):
                 uid, b.position, b.orientation, b.linear_velocity, b.angular_velocity
             )
         if self._prop_uids:
-            for uid, pos in zip(self._prop_uids, self._prop_table[0], strict=True):
+            for uid, pos in zip(self._prop_uids, self._props.at(0), strict=True):
                 self.sim.move(uid, pos)
         self._tick = 0
         self._zeros3n = [0.0] * (3 * self._n)
@@ -428,15 +506,25 @@ class SGCEnv(gym.Env):
         self._failed = not ok
         self._spin_clamped = spin >= SPIN_CLAMP**2
 
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        a = action if type(action) is np.ndarray else np.asarray(action, dtype=np.float64)
+    def step(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
+        self, action: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
+        if self._closed:
+            self._check_open()
+        a = action if type(action) is np.ndarray else np.asarray(action)
+        if a.dtype.kind not in "fiu":
+            raise TypeError(f"action must hold real numbers, got dtype {a.dtype}: {action!r}")
         if a.shape != self._action_shape:
             raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
         values = a.tolist()
-        if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
-            raise ValueError(f"action contains non-finite values: {values}")
-        if max(values) > 1.0 or min(values) < -1.0:
+        hi, lo = max(values), min(values)
+        if hi > 1.0 or lo < -1.0:
+            if hi == math.inf or lo == -math.inf:
+                raise ValueError(f"action contains non-finite values: {values}")
             values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
+        # Clipped first, so the sum cannot overflow: it is NaN only if an entry is.
+        if math.isnan(sum(values)):
+            raise ValueError(f"action contains non-finite values: {values}")
         use_torque = self.use_torque
         per = 6 if use_torque else 3
         gx, gy, gz = self._gravity
@@ -466,12 +554,12 @@ class SGCEnv(gym.Env):
                 for kh, c in coef
             ]
             drives.append((self._uids[i], f, tq, path))
-        moves: list[list[tuple[int, tuple[float, float, float]]]] = []
+        moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
-            last = len(self._prop_table) - 1  # props hold still if stepped past truncation
+            at = self._props.at
             moves = [
-                list(zip(self._prop_uids, self._prop_table[min(base + k + 1, last)], strict=True))
+                list(zip(self._prop_uids, at(base + k + 1), strict=True))
                 for k in range(self.substeps)
             ]
         self.sim.step_bodies(drives, moves)
@@ -485,16 +573,17 @@ class SGCEnv(gym.Env):
             if changed:
                 self._observe(read=False)
         terminated = self._failed
-        reward = task.reward(values, events, terminated, self.max_steps - self._tick)
+        steps_left = self.max_steps - self._tick
+        reward = task.reward_function(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":
             self.render()
         return self._obs, reward, terminated, truncated, info
 
-    def _info(self, events: list[GoalEvent]) -> dict[str, Any]:
+    def _info(self, events: list[GoalEvent]) -> StepInfo:
         block, tail = self._block, self._tail
-        info: dict[str, Any] = {
+        info: StepInfo = {
             "time": self._tick * self.dt,
             "goal_index": self.task.goal_index.copy(),
             "orientation_goal_index": self.task.orientation_goal_index.copy(),
@@ -527,11 +616,29 @@ class SGCEnv(gym.Env):
         self.task.restore(task_counters, self._tick)
 
     def save_state(self) -> SavedState:
-        """Snapshot physics (PyBullet saveState, in memory) and the env's goal counters."""
-        return SavedState(self.sim.save_state(), self._counters())
+        """Snapshot physics (PyBullet saveState, in memory, ~100 KB) and the goal counters.
+
+        The PyBullet copy is freed by :meth:`SavedState.free` (or :meth:`free_state`), when the
+        snapshot is garbage-collected, or when the env closes, whichever comes first.
+        """
+        self._check_open()
+        state = SavedState(self.sim.save_state(), self._counters())
+        object.__setattr__(
+            state,
+            "_release",
+            weakref.finalize(state, _remove_state, weakref.ref(self.sim), state.bullet_state),
+        )
+        return state
+
+    def free_state(self, state: SavedState) -> None:
+        """Free a snapshot's PyBullet copy now (restoring it afterwards is an error)."""
+        state.free()
 
     def restore_state(self, state: SavedState) -> np.ndarray:
         """Return to a :meth:`save_state` snapshot; returns the observation there."""
+        self._check_open()
+        if not state.alive:
+            raise ValueError("this saved state was freed (SavedState.free); save a new one")
         self.sim.restore_state(state.bullet_state)
         self._apply_counters(state.counters)
         self._observe()
@@ -549,6 +656,7 @@ class SGCEnv(gym.Env):
         the body's velocities at once, as an impact would. Policies see the push in the
         returned observation, which replaces the one from the last step.
         """
+        self._check_open()
         i = self.scenario.body_index(body) if isinstance(body, str) else int(body)
         if not 0 <= i < self._n:
             raise ValueError(f"body: no body {body!r} in a scene of {self._n}")
@@ -565,6 +673,7 @@ class SGCEnv(gym.Env):
         return self._obs
 
     def __getstate__(self) -> dict[str, Any]:
+        self._check_open()
         return {
             "init_kwargs": self._init_kwargs,
             "counters": self._counters(),
@@ -585,6 +694,7 @@ class SGCEnv(gym.Env):
     # ---------------------------------------------------------------- rendering
 
     def render(self) -> np.ndarray | None:
+        self._check_open()
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
             return None
@@ -597,7 +707,14 @@ class SGCEnv(gym.Env):
         return None
 
     def close(self) -> None:
-        if getattr(self, "sim", None) is not None:
-            self.sim.close()
+        """Disconnect the PyBullet client (saved states go with it). Idempotent."""
+        sim = getattr(self, "sim", None)
+        if sim is not None:
+            sim.close()
             self.sim = None  # type: ignore[assignment]
+        self._closed = True
         super().close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError("this SGCEnv is closed (close() was called); make a new env")

@@ -23,15 +23,14 @@ import numpy as np
 from sgc_env.observation import float32_residuals
 from sgc_env.paper.quaternion import log as rotvec_from_quat
 from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
-from sgc_env.paper.quaternion import rotate
+from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
 
 from .rewards import DistanceReward
-from .tracks import BodyTracks, Track, compile_tracks, unwrap_rotvec
+from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
     "BodyState",
-    "DistanceReward",
     "GoalEvent",
     "GoalTask",
     "RewardFunction",
@@ -48,8 +47,8 @@ _ZERO13 = (0.0,) * 13
 
 
 class GoalEvent(TypedDict):
-    """A goal whose tick this is: the errors are the norms of D and phi at that tick (None for a
-    part the goal does not have)."""
+    """A goal whose tick this is: the errors are |D| and the angle between the body and the goal
+    orientation (in [0, pi]) at that tick (None for a part the goal does not have)."""
 
     body: int
     goal: int
@@ -82,6 +81,13 @@ class RewardFunction(Protocol):
     ) -> float: ...
 
 
+def rotation_angle(phi: Sequence[float]) -> float:
+    """The angle (in [0, pi]) between the body and the goal orientation: ``|phi|`` folded,
+    because the unwrapped deviation can be longer than pi (7.35 rad is 1.07 rad away)."""
+    angle = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) % math.tau
+    return min(angle, math.tau - angle)
+
+
 def _course_fields(track: Track, k: int) -> tuple[float, ...]:
     """The 13 static observation entries of a track's course ``k``: course start and duration,
     next start and duration, end velocity (last goal only) and the two flags."""
@@ -104,10 +110,12 @@ class GoalTask:
     """Goal tracking of every body of one resolved scenario (see the module docstring).
 
     Per step the env calls :meth:`measure` with the bodies' states, then :meth:`advance` on a
-    tick where a goal falls (:attr:`next_event`), then :meth:`reward`. After :meth:`measure`
-    the public lists hold, per body: :attr:`points` (world position of the tracked point),
-    :attr:`deviations` (D and D', zeros without a position track), :attr:`phi` (unwrapped
-    rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`.
+    tick where a goal falls (:attr:`next_event`), then :attr:`reward_function`. After
+    :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
+    tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
+    (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`;
+    and :attr:`scaled_deviation`, ``sum_b |D_b| / L_b + |phi_b| / A_b`` with the current course's
+    scales (:attr:`position_scale` = 1 / L, :attr:`orientation_scale` = 1 / A).
     """
 
     def __init__(
@@ -142,6 +150,7 @@ class GoalTask:
         self.deviations: list[tuple[float, ...]] = []
         self.position_time_left: list[float] = []
         self.orientation_time_left: list[float] = []
+        self.scaled_deviation = 0.0
         self.time = 0.0
         self.reset()
 
@@ -221,16 +230,19 @@ class GoalTask:
 
     def measure(self, states: Sequence[BodyState], time: float) -> None:
         """Deviations of every body from its current goals at ``time`` (see the class)."""
-        offsets, has_pos, has_ori, phis = (
-            self.offsets,
-            self.has_position,
-            self.has_orientation,
-            self.phi,
+        offsets, nails, phis = self.offsets, self.nails, self.phi
+        has_pos, has_ori = self.has_position, self.has_orientation
+        ptime, otime, goal_q = (
+            self.position_goal_time,
+            self.orientation_goal_time,
+            self.goal_quaternions,
         )
+        pscale, oscale = self.position_scale, self.orientation_scale
         points = []
-        deviations = []
+        deviations: list[tuple[float, ...]] = []
         ptls = []
         otls = []
+        cost = 0.0
         for i, (pos, orn, lin, ang) in enumerate(states):
             offset = offsets[i]
             if offset == _ZERO3:
@@ -240,29 +252,32 @@ class GoalTask:
                 p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
             points.append(p)
             if has_pos[i]:
-                nail = self.nails[i]
+                nail = nails[i]
                 wx, wy, wz = ang
+                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
                 deviations.append(
                     (
-                        p[0] - nail[0], p[1] - nail[1], p[2] - nail[2],
-                        lin[0] + wy * r[2] - wz * r[1], lin[1] + wz * r[0] - wx * r[2],
-                        lin[2] + wx * r[1] - wy * r[0],
+                        dx, dy, dz, lin[0] + wy * r[2] - wz * r[1],
+                        lin[1] + wz * r[0] - wx * r[2], lin[2] + wx * r[1] - wy * r[0],
                     )
                 )  # fmt: skip
-                ptls.append(self.position_goal_time[i] - time)
+                ptls.append(ptime[i] - time)
+                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * pscale[i]
             else:
                 deviations.append(_ZERO6)
                 ptls.append(0.0)
             if has_ori[i]:
-                q = quat_conj_mul(orn, self.goal_quaternions[i])
-                phis[i] = unwrap_rotvec(rotvec_from_quat(q), phis[i])
-                otls.append(self.orientation_goal_time[i] - time)
+                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, goal_q[i])), phis[i])
+                phis[i] = phi
+                otls.append(otime[i] - time)
+                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * oscale[i]
             else:
                 otls.append(0.0)
         self.points = points
         self.deviations = deviations
         self.position_time_left = ptls
         self.orientation_time_left = otls
+        self.scaled_deviation = cost
         self.time = time
 
     def advance(self, tick: int) -> tuple[list[GoalEvent], bool]:
@@ -305,7 +320,7 @@ class GoalTask:
                             "orientation_error": None,
                         },
                     )
-                    ev["orientation_error"] = math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2)
+                    ev["orientation_error"] = rotation_angle(phi)
                 if k < to.size - 1:
                     self.ori_idx[i] = k + 1
                     start = to.course_start[k + 1]
@@ -318,15 +333,6 @@ class GoalTask:
                 any_changed = True
         self.next_event = self._first_pending_tick(tick)
         return events, any_changed
-
-    def reward(
-        self,
-        action: Sequence[float],
-        events: Sequence[GoalEvent],
-        terminated: bool = False,
-        steps_left: int = 0,
-    ) -> float:
-        return self.reward_function(self, action, events, terminated, steps_left)
 
     # ---------------------------------------------------------------- goal-conditioned view
 

@@ -1,4 +1,4 @@
-"""Per-body goal tracks compiled from a resolved scenario (the env's "task" data).
+"""Per-body goal tracks compiled from a resolved scenario (the data :mod:`.task` runs on).
 
 A body's goals split into a position track (goals with a nail) and an orientation track
 (goals with an orientation part). Everything the observation needs about the current and next
@@ -7,63 +7,15 @@ course is precomputed here once per scenario, so a control step only indexes arr
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from sgc_env.paper import quaternion
-from sgc_env.paper.orientation import MAX_COURSE_ROTATION, course_pieces
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.orientation import split_rotation
 from sgc_env.scenario import Body, Scenario
 
-__all__ = [
-    "BodyTracks",
-    "Track",
-    "compile_tracks",
-    "quat_conj_mul",
-    "quat_from_rotvec",
-    "quat_mul",
-    "rotate",
-    "rotvec_from_quat",
-    "unwrap_rotvec",
-]
-
-
-quat_mul = quaternion.mul
-rotate = quaternion.rotate
-rotvec_from_quat = quaternion.log
-quat_from_rotvec = quaternion.exp_normalized
-
-
-quat_conj_mul = quaternion.mul_conjugate
-"""a * conj(b): the rotation R_a R_b^T."""
-
-
-def unwrap_rotvec(
-    principal: Sequence[float], reference: Sequence[float]
-) -> tuple[float, float, float]:
-    """The rotation vector of the same rotation that lies closest to ``reference``.
-
-    Same rotation = axis * (angle + 2 pi k) for any integer k, so the deviation phi stays
-    continuous across steps and a somersault's |phi| can exceed pi.
-    """
-    px, py, pz = principal
-    angle = math.sqrt(px * px + py * py + pz * pz)
-    rx, ry, rz = reference
-    if angle < 1e-12:
-        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
-        if rn < math.pi:
-            return (px, py, pz)
-        ux, uy, uz = rx / rn, ry / rn, rz / rn
-    else:
-        ux, uy, uz = px / angle, py / angle, pz / angle
-    s = ux * rx + uy * ry + uz * rz
-    k = round((s - angle) / (2.0 * math.pi))
-    if k == 0:
-        return (px, py, pz)
-    a = angle + 2.0 * math.pi * k
-    return (ux * a, uy * a, uz * a)
+__all__ = ["BodyTracks", "Track", "compile_tracks"]
 
 
 @dataclass
@@ -112,7 +64,7 @@ def _position_track(body: Body, freq: int) -> Track | None:
     times = np.array([float(g.time) for g in goals])  # type: ignore[arg-type]
     nails = np.array([g.nail for g in goals], float)
     points = np.array([g.point for g in goals], float)
-    start_point = np.add(body.position, rotate(body.orientation, points[0]))
+    start_point = np.add(body.position, quat.rotate(body.orientation, points[0]))
     prev = np.vstack((start_point, nails[:-1]))
     course_start = prev - nails
     if body.end_velocity is not None:
@@ -124,21 +76,6 @@ def _position_track(body: Body, freq: int) -> Track | None:
         np.zeros(0), np.zeros(0), np.zeros(0), end_v,
     )  # fmt: skip
     return _finish(track)
-
-
-def _pieces(rel: Sequence[float], t0: float, t1: float, freq: int, where: str):
-    """Equal sub-rotations of ``rel`` with their times on the control grid."""
-    angle = math.sqrt(sum(c * c for c in rel))
-    m = course_pieces(rel)
-    k0, k1 = round(t0 * freq), round(t1 * freq)
-    if k1 - k0 < m:
-        raise ValueError(
-            f"{where}: a relative rotation of {angle:.6g} rad is split into {m} courses of at "
-            f"most {MAX_COURSE_ROTATION:.4g} rad, which needs {m} control ticks before the goal "
-            f"time but only {k1 - k0} are left; give the goal more time"
-        )
-    step = tuple(c / m for c in rel)
-    return [(step, (k0 + round(i * (k1 - k0) / m)) / freq, i == m) for i in range(1, m + 1)]
 
 
 def _orientation_track(body: Body, freq: int) -> Track | None:
@@ -153,12 +90,13 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
         t = float(g.time)  # type: ignore[arg-type]
         if g.relative_rotation is not None:
             rel = tuple(float(x) for x in g.relative_rotation)
-            pieces = _pieces(rel, prev_t, t, freq, f"{body.name}.goals[{j}]")
+            split = split_rotation(rel, prev_t, t, freq, f"{body.name}.goals[{j}]")
+            pieces = [(step, end, k == len(split) - 1) for k, (step, end) in enumerate(split)]
         else:
             q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
-            pieces = [(rotvec_from_quat(quat_conj_mul(q, prev_q)), t, True)]
+            pieces = [(quat.log(quat.mul_conjugate(q, prev_q)), t, True)]
         for step, t_piece, last in pieces:
-            prev_q = quat_mul(quat_from_rotvec(step), prev_q) if g.relative_rotation else q
+            prev_q = quat.mul(quat.exp_normalized(step), prev_q) if g.relative_rotation else q
             goal_ids.append(j)
             quats.append(prev_q)
             starts.append((-step[0], -step[1], -step[2]))

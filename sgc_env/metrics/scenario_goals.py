@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import cast
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -23,25 +26,34 @@ def goals_from_scenario(scenario: Scenario) -> list[list[GoalSpec]]:
         previous = Rotation.from_quat(np.asarray(body.orientation, dtype=float))
         specs = []
         for goal in body.goals:
-            orientation = None
+            orientation: tuple[float, float, float, float] | None = None
             angle = None
             if goal.relative_rotation is not None:
                 rel = np.asarray(goal.relative_rotation, dtype=float)
                 previous = Rotation.from_rotvec(rel) * previous
-                orientation = tuple(float(x) for x in previous.as_quat())
+                orientation = _quat(previous.as_quat())
                 angle = float(np.linalg.norm(rel))
             elif goal.orientation is not None:
                 previous = Rotation.from_quat(np.asarray(goal.orientation, dtype=float))
-                orientation = tuple(float(x) for x in goal.orientation)
-            has_nail = goal.nail is not None
+                orientation = _quat(goal.orientation)
             specs.append(
                 GoalSpec(
-                    time=float(goal.time),
-                    nail=tuple(float(x) for x in goal.nail) if has_nail else None,
+                    time=float(cast(float, goal.time)),  # resolved: every goal has its time
+                    nail=None if goal.nail is None else _vec3(goal.nail),
                     orientation=orientation,
-                    point=tuple(float(x) for x in goal.point) if has_nail else None,
+                    point=None if goal.nail is None else _vec3(goal.point),
                     rotation_angle=angle,
                 )
             )
         out.append(specs)
     return out
+
+
+def _vec3(v: Sequence[float]) -> tuple[float, float, float]:
+    x, y, z = (float(c) for c in v)
+    return x, y, z
+
+
+def _quat(q: Sequence[float]) -> tuple[float, float, float, float]:
+    x, y, z, w = (float(c) for c in q)
+    return x, y, z, w

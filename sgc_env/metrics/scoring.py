@@ -125,6 +125,8 @@ def _orientation_goal_metrics(
     out = []
     windows = _windows([g.time for g in goals], start_time)
     for goal, (lo, hi) in zip(goals, windows, strict=True):
+        if goal.orientation is None:
+            raise ValueError(f"goal at t={goal.time}: orientation metrics need an orientation")
         target = Rotation.from_quat(np.asarray(goal.orientation, dtype=float))
         err = traj.orientation_error(goal.orientation)
         error = float((traj.orientation_at(goal.time) * target.inv()).magnitude())

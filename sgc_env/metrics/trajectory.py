@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from sgc_env.defaults import ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 from sgc_env.metrics.signals import FloatArray, as_finite_array, check_times, locate
 
 
@@ -54,8 +55,8 @@ class Tolerances:
     `time=None` means one control step (the trajectory's dt).
     """
 
-    position: float = 0.02
-    orientation: float = 0.05
+    position: float = POSITION_TOLERANCE
+    orientation: float = ORIENTATION_TOLERANCE
     time: float | None = None
 
     def __post_init__(self) -> None:

@@ -28,8 +28,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+Num = float | np.ndarray
+Floats3 = tuple[float, float, float]
+Arrays3 = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""A float or an array of them (the profiles evaluate either elementwise)."""
 
 __all__ = [
     "BRANCH_CODES",
@@ -183,7 +190,7 @@ def _solve_xi(y: float) -> float:
     """Root ``xi`` of ``phi(xi) = y``: table guess, then safeguarded Newton."""
     if _Y0 <= y < _Y1:
         q = (y - _Y0) / _H
-        i = int(q)
+        i = min(int(q), _N - 1)  # y just below _Y1 can round to q == _N, as in _solve_xi_vec
         r = q - i
         x0, x1 = _TAB_XI[i], _TAB_XI[i + 1]
         m0, m1 = _TAB_DXI[i] * _H, _TAB_DXI[i + 1] * _H
@@ -217,8 +224,9 @@ class CourseProfile:
     )
 
     def __init__(
-        self, d0, v0, duration, k, alpha, beta_squared, branch, z, w, s, p, m
-    ) -> None:
+        self, d0: float, v0: float, duration: float, k: float, alpha: float,
+        beta_squared: float, branch: str, z: float, w: float, s: float, p: float, m: float,
+    ) -> None:  # fmt: skip
         self.d0 = d0
         self.v0 = v0
         self.duration = duration
@@ -292,7 +300,7 @@ class CourseProfile:
             d, v, a = _osc_profile(self._m, self._s, self._p, tau, u)
         else:
             d, v, a = _over_profile(self._m, self._w, tau, u)
-        return self.d0 * d, self.d0 * v / T, self.d0 * a / (T * T)
+        return cast(Arrays3, (self.d0 * d, self.d0 * v / T, self.d0 * a / (T * T)))
 
     def position(self, t: float | np.ndarray) -> float | np.ndarray:
         """``D(t)``."""
@@ -344,7 +352,7 @@ def _like(value: np.ndarray, t: float | np.ndarray) -> float | np.ndarray:
     return float(value) if np.ndim(t) == 0 else value
 
 
-def _osc_profile(big_a, s, p, tau, u):
+def _osc_profile(big_a: Num, s: Num, p: Num, tau: Num, u: Num) -> tuple[Num, Num, Num]:
     """Normalised ``(D, dD/dtau, d2D/dtau2) / d0`` on the oscillatory branch (arrays ok)."""
     pre = np.exp(big_a * tau) / np.where(s < 1.5, np.sin(s), np.sin(p))
     su = s * u
@@ -359,7 +367,7 @@ def _osc_profile(big_a, s, p, tau, u):
     )
 
 
-def _over_profile(m, w, tau, u):
+def _over_profile(m: Num, w: Num, tau: Num, u: Num) -> tuple[Num, Num, Num]:
     """Normalised ``(D, dD/dtau, d2D/dtau2) / d0`` for ``z <= 0`` (arrays ok)."""
     two_w = 2.0 * np.asarray(w, dtype=float)
     safe = np.where(two_w > 0.0, two_w, 1.0)
@@ -505,7 +513,7 @@ def _solve_xi_vec(y: np.ndarray) -> np.ndarray:
     return xi
 
 
-def solve_batch(d0, v0, duration, k) -> CourseBatch:
+def solve_batch(d0: ArrayLike, v0: ArrayLike, duration: ArrayLike, k: ArrayLike) -> CourseBatch:
     """Vectorised :meth:`CourseProfile.solve` over broadcastable arrays.
 
     Same validation and the same root (to rounding) as the scalar solver; a ValueError names
@@ -571,13 +579,13 @@ class HermiteProfile:
 
     def state(self, t: float) -> tuple[float, float, float]:
         """``(D, D', D'')`` at scalar ``t`` (plain floats: the expert's per-step path)."""
-        return self._cubic(float(t) / self.duration)
+        return cast(Floats3, self._cubic(float(t) / self.duration))
 
     def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(D, D', D'')`` at ``t`` seconds from the course start."""
-        return self._cubic(np.asarray(t, dtype=float) / self.duration)
+        return cast(Arrays3, self._cubic(np.asarray(t, dtype=float) / self.duration))
 
-    def _cubic(self, s):
+    def _cubic(self, s: Num) -> tuple[Num, Num, Num]:
         """The cubic and its derivatives at normalised time ``s`` (a float or an array)."""
         T = self.duration
         d0, m0, m1 = self.d0, self.v0 * T, self.end_velocity * T
@@ -587,13 +595,13 @@ class HermiteProfile:
         a = d0 * (12 * s - 6) + m0 * (6 * s - 4) + m1 * (6 * s - 2)
         return d, v / T, a / (T * T)
 
-    def position(self, t):
+    def position(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[0], t)
 
-    def velocity(self, t):
+    def velocity(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[1], t)
 
-    def acceleration(self, t):
+    def acceleration(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[2], t)
 
 
@@ -611,11 +619,11 @@ class HoldProfile:
         zero = np.zeros_like(np.asarray(t, dtype=float))
         return zero, zero.copy(), zero.copy()
 
-    def position(self, t):
+    def position(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[0], t)
 
-    def velocity(self, t):
+    def velocity(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[1], t)
 
-    def acceleration(self, t):
+    def acceleration(self, t: float | np.ndarray) -> float | np.ndarray:
         return _like(self.evaluate(t)[2], t)

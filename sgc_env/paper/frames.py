@@ -22,22 +22,62 @@ turns the component arrives at a quarter of the slower average speed instead of 
 Eq. 14 itself needs the frame ``S_{i+1}``, which depends on the goal after next; the solver
 is total (it covers ``gamma T <= -1``), so eq. 14 is reported (:func:`condition_14`), not
 enforced.
+
+Beyond the paper: the tangent rule (``rule="tangent"``). The paper's k rules set each
+component's end speed from its own ``rho``, so every goal gets a speed pulse. The tangent rule
+instead gives an interior goal the end velocity of a smooth path through the neighbouring
+nails: direction ``nail_{i+1} - nail_{i-1}`` (``= -(D_i(0) + Delta_{i+1}(0))``; for the first
+course the start point stands for ``nail_{i-1}``), speed the mean of the two courses' average
+speeds ``|D_i(0)|/t_i`` and ``|Delta_{i+1}(0)|/t_{i+1}`` (:func:`tangent_speed`). It is
+realised per component of ``S_i`` through ``k_j = -v_j t_i / D_j(0)``, so the course is still
+an SGC course: exact and punctual. Where it cannot be realised it falls back to the paper's
+rule for that goal (``rule`` reported ``"sgc"``):
+
+* a sign change in ``S_i``: some ``k_j < k_min`` (the tangent leaves the cone of directions that
+  approach the nail in every component, or nearly so: a component would arrive at less than
+  ``k_min`` of its average speed or move away from the nail);
+* a hairpin (the next nail is the previous one): the chord has no direction.
+
+The paper's pi/6 assumption is what bounds ``rho`` for eqs. 12-13; the tangent rule does not
+use ``rho``, and its cone of realisable directions is wider: between two courses of equal
+speed it is realised up to a turn of about 86 degrees (every component of ``S_i`` keeps at
+least ``k_min`` of its average), where the paper's own rule already needs its ``rho <= 0``
+extension beyond 54.7 degrees. So a turn beyond pi/6 alone does not make it fall back
+(``within_paper_assumption`` still reports it): falling back there too measured SGCRod-v0's
+whole-track SPARC back at the paper's (-2.42 against -2.22, seeds 10000-10009).
+
+A change of pace: where one average speed is more than :data:`PACE_CHANGE` times the other, the
+speed is the next course's average instead of the mean (the paper's choice too: eqs. 12-13 with
+``c`` near 1), so the new pace starts at the goal and the next course is not made to sag or
+bulge. Measured on the three-rod teal rod, whose somersault course is about four times slower
+than its neighbours: with the mean its whole-track SPARC was -2.444 (paper: -2.422), with the
+switch -2.383.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
 from sgc_env.paper.course import CourseProfile, HermiteProfile, HoldProfile
+from sgc_env.paper.end_rules import END_RULES
+
+Vec3 = tuple[float, float, float]
+Rows = tuple[Vec3, Vec3, Vec3]
+"""A frame ``S_i`` as three row tuples (world unit vectors)."""
+Vector = Sequence[float] | np.ndarray
+"""A 3-vector as any sequence of floats or an array."""
+Profile = CourseProfile | HermiteProfile | HoldProfile
 
 __all__ = [
     "C_HIGH",
     "C_LOW",
+    "END_RULES",
     "K_MIN",
+    "PACE_CHANGE",
     "PAPER_MAX_TURN",
     "EndVelocity",
     "FrameCourse",
@@ -47,6 +87,7 @@ __all__ = [
     "next_deviation",
     "normalized_frame",
     "solve_course_in_frame",
+    "tangent_speed",
     "turn_angle",
 ]
 
@@ -54,12 +95,14 @@ C_LOW = 0.9
 C_HIGH = 0.95
 K_MIN = 0.25
 PAPER_MAX_TURN = math.pi / 6.0
+PACE_CHANGE = 3.0
+"""Ratio of neighbouring average speeds above which the tangent speed is the next course's."""
 _SQ3 = 1.0 / math.sqrt(3.0)
 _SQ6 = 1.0 / math.sqrt(6.0)
 _SQ2 = 1.0 / math.sqrt(2.0)
 
 
-def _vec3(x, name: str) -> tuple[float, float, float]:
+def _vec3(x: Vector, name: str) -> Vec3:
     """Three Python floats (the hot path avoids numpy on 3-vectors); validates finiteness."""
     try:
         a0, a1, a2 = (x.tolist() if isinstance(x, np.ndarray) else x)
@@ -71,7 +114,7 @@ def _vec3(x, name: str) -> tuple[float, float, float]:
     return a0, a1, a2
 
 
-def _frame_rows(d, nxt):
+def _frame_rows(d: Vec3, nxt: Vec3 | None) -> tuple[Rows, float] | None:
     """Rows of ``S_i`` (world unit vectors) from Python-float 3-tuples; None if ``d`` is 0."""
     d0, d1, d2 = d
     norm = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
@@ -114,7 +157,7 @@ def _frame_rows(d, nxt):
     ), norm
 
 
-def _mul(rows, v) -> tuple[float, float, float]:
+def _mul(rows: Rows, v: Vec3) -> Vec3:
     """``R @ v`` for rows and a vector given as tuples."""
     v0, v1, v2 = v
     r0, r1, r2 = rows
@@ -125,7 +168,7 @@ def _mul(rows, v) -> tuple[float, float, float]:
     )
 
 
-def _mul_t(rows, s):
+def _mul_t(rows: Rows, s: Vec3) -> Vec3:
     """``R.T @ s``."""
     s0, s1, s2 = s
     r0, r1, r2 = rows
@@ -136,7 +179,7 @@ def _mul_t(rows, s):
     )
 
 
-def normalized_frame(d_start, d_next=None) -> np.ndarray:
+def normalized_frame(d_start: Vector, d_next: Vector | None = None) -> np.ndarray:
     """Rotation matrix ``R`` of ``S_i``: ``R @ v`` are the components of world ``v`` in ``S_i``.
 
     ``R @ d_start = |d_start|/sqrt3 (1, 1, 1)``; ``R @ d_next`` lies in the plane of
@@ -152,7 +195,7 @@ def normalized_frame(d_start, d_next=None) -> np.ndarray:
     return np.array(out[0])
 
 
-def turn_angle(d_start, d_next) -> float:
+def turn_angle(d_start: Vector, d_next: Vector) -> float:
     """Angle between ``D_i(0)`` and ``Delta_{i+1}(0)`` (0 if either is zero)."""
     a0, a1, a2 = _vec3(d_start, "d_start")
     b0, b1, b2 = _vec3(d_next, "d_next")
@@ -179,7 +222,9 @@ def choose_k(
 class EndVelocity(NamedTuple):
     """Diagnostics of :func:`course_end_velocity`.
 
-    ``rule``: ``"sgc"`` (eqs. 12-13), ``"last"`` (no next course: user or average velocity),
+    ``rule``: ``"sgc"`` (eqs. 12-13, also where the tangent rule falls back), ``"tangent"``
+    (the chord through the neighbouring nails), ``"last"`` (no next course: user or average
+    velocity),
     ``"rest"`` (arrive at rest: the next course is a dwell, or a zero end velocity was asked
     for) or ``"dwell"`` (this course is one). ``within_paper_assumption`` is False when the
     turn exceeds ``pi/6``, some ``rho <= 0``, or a user end velocity was clamped. ``frame``
@@ -215,17 +260,21 @@ def _negligible(nxt: tuple[float, float, float], d: tuple[float, float, float]) 
 
 
 def course_end_velocity(
-    d_start,
-    d_next,
+    d_start: Vector,
+    d_next: Vector | None,
     t_course: float,
     t_next: float | None,
     *,
-    end_velocity=None,
+    end_velocity: Vector | None = None,
     c_low: float = C_LOW,
     c_high: float = C_HIGH,
     k_min: float = K_MIN,
+    rule: str = "paper",
 ) -> tuple[np.ndarray, EndVelocity]:
     """World end velocity ``D_i'(t_i)`` of course ``i`` and its diagnostics.
+
+    ``rule``: ``"paper"`` (eqs. 12-13) or ``"tangent"`` (module docstring; it changes interior
+    goals only and falls back to the paper's rule where it cannot be realised).
 
     ``d_start = D_i(0)``, ``d_next = Delta_{i+1}(0)`` (None for the last goal),
     ``t_course = t_i``, ``t_next = t_{i+1}``. Rules for what the paper does not cover:
@@ -241,11 +290,15 @@ def course_end_velocity(
 
     Plain-float arithmetic: this runs every control step of the expert.
     """
+    if rule not in END_RULES:
+        raise ValueError(f"rule must be one of {list(END_RULES)}, got {rule!r}")
     d = _vec3(d_start, "d_start")
     if not (math.isfinite(t_course) and t_course > 0.0):
         raise ValueError(f"t_course must be finite and > 0, got {t_course!r}")
-    nxt = None if d_next is None else _vec3(d_next, "d_next")
-    if nxt is not None and _negligible(nxt, d):
+    nxt: tuple[float, float, float] | str | None = (
+        None if d_next is None else _vec3(d_next, "d_next")
+    )
+    if isinstance(nxt, tuple) and _negligible(nxt, d):
         nxt = "rest"
     elif nxt is not None and (t_next is None or not (math.isfinite(t_next) and t_next > 0.0)):
         raise ValueError(f"t_next must be finite and > 0, got {t_next!r}")
@@ -274,22 +327,61 @@ def course_end_velocity(
         zeros = np.zeros(3)
         return zeros, EndVelocity(zeros, np.array(rows), np.full(3, np.nan), zeros, 0.0, True,
                                   "rest")
-    if nxt is not None:
-        rho = tuple(c / t_next / avg for c in _mul(rows, nxt))
+    if isinstance(nxt, tuple) and t_next is not None:  # t_next was checked with nxt above
+        r0, r1, r2 = _mul(rows, nxt)
+        rho = (r0 / t_next / avg, r1 / t_next / avg, r2 / t_next / avg)
         n0, n1, n2 = nxt
         speed_ratio = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) * t_course / (norm * t_next)
         k_floor = k_min * min(1.0, speed_ratio)
         ks = [_k_rule(r, c_low, c_high) if r > 0.0 else k_floor for r in rho]
         angle = turn_angle(d, nxt)
         within = angle <= PAPER_MAX_TURN + 1e-12 and min(rho) > 0.0
-        rule = "sgc"
+        tangent = None
+        if rule == "tangent":
+            tangent = _tangent_k(rows, d, nxt, norm, avg, t_course, t_next, k_min)
+        if tangent is None:
+            rule = "sgc"
+        else:
+            ks, rule = tangent, "tangent"
     else:
         ks = [k if k >= k_min else k_min for k in ks]
     v = np.array(_mul_t(rows, (-ks[0] * avg, -ks[1] * avg, -ks[2] * avg)))
     return v, EndVelocity(v, np.array(rows), np.array(rho), np.array(ks), angle, within, rule)
 
 
-def condition_14(end_velocity, d_next, t_next: float, d_after=None) -> bool:
+def tangent_speed(average: float, next_average: float) -> float:
+    """Speed of the tangent rule at a goal from the average speeds of its two courses.
+
+    Their mean; at a change of pace by more than :data:`PACE_CHANGE` the next course's
+    average (module docstring).
+    """
+    if max(average, next_average) > PACE_CHANGE * min(average, next_average):
+        return next_average
+    return 0.5 * (average + next_average)
+
+
+def _tangent_k(
+    rows: Rows, d: Vec3, nxt: Vec3, norm: float, avg: float, t_course: float,
+    t_next: float, k_min: float,
+) -> list[float] | None:
+    """Per-component ``k`` of the tangent rule, or None where it falls back (module docstring).
+
+    ``-(d + nxt)`` is ``nail_{i+1} - nail_{i-1}``: the chord through the goal's neighbours.
+    """
+    c0, c1, c2 = -(d[0] + nxt[0]), -(d[1] + nxt[1]), -(d[2] + nxt[2])
+    chord = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    n0, n1, n2 = nxt
+    speed = tangent_speed(norm / t_course, math.sqrt(n0 * n0 + n1 * n1 + n2 * n2) / t_next)
+    if not chord > 1e-12 * norm:  # a hairpin: the next nail is the previous one
+        return None
+    scale = speed / chord
+    ks = [-c / avg for c in _mul(rows, (c0 * scale, c1 * scale, c2 * scale))]
+    return ks if min(ks) >= k_min else None
+
+
+def condition_14(
+    end_velocity: Vector, d_next: Vector, t_next: float, d_after: Vector | None = None
+) -> bool:
     """Eq. 14: in ``S_{i+1}`` every component of the incoming velocity is slower than the
     next course's average, ``-D'_{i+1,j}(0) < D_{i+1,j}(0) / t_{i+1}``."""
     frame = normalized_frame(d_next, d_after)
@@ -303,10 +395,12 @@ class FrameCourse:
 
     __slots__ = ("profiles", "duration", "_rows")
 
-    def __init__(self, frame, profiles: Sequence, duration: float) -> None:
+    def __init__(
+        self, frame: np.ndarray | Rows, profiles: Sequence[Profile], duration: float
+    ) -> None:
         """``frame``: ``S_i`` as a 3x3 array or as a tuple of three row tuples."""
         rows = frame.tolist() if isinstance(frame, np.ndarray) else frame
-        self._rows = tuple(tuple(float(x) for x in r) for r in rows)
+        self._rows: Rows = cast(Rows, tuple(tuple(float(x) for x in r) for r in rows))
         self.profiles = tuple(profiles)
         self.duration = duration
 
@@ -326,7 +420,7 @@ class FrameCourse:
             np.array(_mul_t(rows, (s0[2], s1[2], s2[2]))),
         )
 
-    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """World ``(D, D', D'')`` at an array of times: each of shape ``t.shape + (3,)``."""
         parts = [p.evaluate(t) for p in self.profiles]
         out = []
@@ -348,7 +442,11 @@ _IDENTITY_ROWS = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 def solve_course_in_frame(
-    frame: np.ndarray | None, deviation_now, velocity_now, time_left: float, end_velocity
+    frame: np.ndarray | Rows | None,
+    deviation_now: Vector,
+    velocity_now: Vector,
+    time_left: float,
+    end_velocity: Vector,
 ) -> FrameCourse:
     """Solve the rest of a course from the current state (what a stateless expert calls).
 
@@ -365,6 +463,7 @@ def solve_course_in_frame(
     """
     if not (math.isfinite(time_left) and time_left > 0.0):
         raise ValueError(f"time_left must be finite and > 0, got {time_left!r}")
+    rows: Any
     if frame is None:
         rows = _IDENTITY_ROWS
     else:
@@ -379,8 +478,9 @@ def solve_course_in_frame(
 
 
 def next_deviation(
-    rows, deviation_now, velocity_now, time_left: float, end_velocity, t: float
-) -> tuple[float, float, float]:
+    rows: Rows, deviation_now: Vec3, velocity_now: Vec3, time_left: float, end_velocity: Vec3,
+    t: float,
+) -> Vec3:  # fmt: skip
     """World ``D(t)`` of the course :func:`solve_course_in_frame` would return, in plain floats.
 
     ``rows``: ``S_i`` as three row tuples (the identity for a dwell), the 3-vectors as tuples
@@ -395,7 +495,9 @@ def next_deviation(
     return _mul_t(rows, (p0.state(t)[0], p1.state(t)[0], p2.state(t)[0]))
 
 
-def _component_profiles(d, v, ve, time_left: float) -> tuple:
+def _component_profiles(
+    d: Vec3, v: Vec3, ve: Vec3, time_left: float
+) -> tuple[Profile, Profile, Profile]:
     """The three component profiles of a course in ``S_i`` (components given in ``S_i``)."""
     rest = ve == _ZERO3
     if rest and d == _ZERO3 and v == _ZERO3:
@@ -408,7 +510,9 @@ def _component_profiles(d, v, ve, time_left: float) -> tuple:
     )
 
 
-def _component_profile(dj: float, vj: float, vej: float, time_left: float, rest: bool):
+def _component_profile(
+    dj: float, vj: float, vej: float, time_left: float, rest: bool
+) -> CourseProfile | HermiteProfile:
     """SGC where it applies, else the Hermite cubic (rules in :func:`solve_course_in_frame`)."""
     k = -vej * time_left / dj if dj != 0.0 else 0.0
     if rest or k <= 0.0:

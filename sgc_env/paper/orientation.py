@@ -15,12 +15,17 @@ and ``omega_dot = J_l phi_ddot + (d/dt J_l) phi_dot``. ``J_l`` is singular where
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
+
+from sgc_env.paper import quaternion
 
 __all__ = [
     "MAX_COURSE_ROTATION",
+    "MAX_RELATIVE_ROTATION",
     "angular_acceleration",
     "course_pieces",
     "angular_velocity",
@@ -30,7 +35,7 @@ __all__ = [
     "orientation_deviation",
     "quat_to_rotvec",
     "rotvec_to_quat",
-    "unwrap_rotvec",
+    "split_rotation",
 ]
 
 _TWO_PI = 2.0 * math.pi
@@ -42,14 +47,58 @@ MAX_COURSE_ROTATION = 2.0 * math.pi / 3.0
 angular velocity across its axis (the plan would start at the wrong angular velocity), and
 from measured states every rotation near the identity has a representative there only along
 one axis. Planner and env therefore split a somersault into equal sub-rotations about the
-same axis, timed evenly, each one a course of its own.
+same axis, each one a course of its own (:func:`split_rotation`, one splitter for both).
 """
 
+MAX_RELATIVE_ROTATION = 64.0 * math.pi
+"""Longest relative rotation of one goal (32 turns, 96 courses): bounds the planner's work."""
 
-def course_pieces(rotation_vector) -> int:
+
+def course_pieces(rotation_vector: ArrayLike) -> int:
     """How many equal courses a relative rotation is split into (see MAX_COURSE_ROTATION)."""
     angle = float(np.linalg.norm(np.asarray(rotation_vector, dtype=float)))
+    if not angle <= MAX_RELATIVE_ROTATION:
+        raise ValueError(
+            f"relative rotation of {angle:.6g} rad is longer than {MAX_RELATIVE_ROTATION:.6g} "
+            "rad (32 turns), the most one goal may ask"
+        )
     return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
+
+
+def split_rotation(
+    rotation_vector: Sequence[float] | np.ndarray,
+    t0: float,
+    t1: float,
+    control_frequency: int | None = None,
+    where: str = "relative rotation",
+) -> list[tuple[tuple[float, float, float], float]]:
+    """A relative rotation from ``t0`` to ``t1`` as :func:`course_pieces` equal sub-rotations
+    about its axis: ``(sub-rotation vector, end time)`` per course (the one splitter of the
+    env's tracks and :func:`sgc_env.paper.plan.plan_body`).
+
+    With ``control_frequency`` the courses are timed as the env times them, on its control
+    grid: course ``i`` of ``m`` ends on tick ``k0 + round(i (k1 - k0) / m)`` with ``k0, k1``
+    the ticks of ``t0, t1``, and fewer ticks than courses is an error naming ``where``.
+    Without it they are spaced evenly in continuous time; the last ends exactly at ``t1``.
+    """
+    rel = tuple(float(c) for c in rotation_vector)
+    try:
+        m = course_pieces(rel)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    step = (rel[0] / m, rel[1] / m, rel[2] / m)
+    if control_frequency is None:
+        return [(step, t1 if i == m else t0 + (t1 - t0) * i / m) for i in range(1, m + 1)]
+    f = control_frequency
+    k0, k1 = round(t0 * f), round(t1 * f)
+    if k1 - k0 < m:
+        angle = math.sqrt(sum(c * c for c in rel))
+        raise ValueError(
+            f"{where}: a relative rotation of {angle:.6g} rad is split into {m} courses of at "
+            f"most {MAX_COURSE_ROTATION:.4g} rad, which needs {m} control ticks before the goal "
+            f"time but only {k1 - k0} are left; give the goal more time"
+        )
+    return [(step, (k0 + round(i * (k1 - k0) / m)) / f) for i in range(1, m + 1)]
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -79,7 +128,7 @@ def _coefficients(theta: float) -> tuple[float, float, float, float]:
     return a, b, da, db
 
 
-def left_jacobian(phi) -> np.ndarray:
+def left_jacobian(phi: ArrayLike) -> np.ndarray:
     """``J_l(phi)``: ``omega = J_l(phi) phi_dot`` for ``R = Exp(phi) R_goal``."""
     phi = np.asarray(phi, dtype=float)
     a, b, _, _ = _coefficients(float(np.linalg.norm(phi)))
@@ -87,7 +136,7 @@ def left_jacobian(phi) -> np.ndarray:
     return np.eye(3) + a * k + b * (k @ k)
 
 
-def left_jacobian_inverse(phi) -> np.ndarray:
+def left_jacobian_inverse(phi: ArrayLike) -> np.ndarray:
     """``J_l(phi)^-1 = I - [phi]x / 2 + (1/theta^2 - (1 + cos)/(2 theta sin)) [phi]x^2``.
 
     Raises ValueError within 1e-9 rad of ``theta = 2 pi n`` where ``J_l`` is singular.
@@ -111,7 +160,9 @@ def _inverse_coefficient(theta: float) -> float:
     return 1.0 / (theta * theta) - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
 
 
-def left_jacobian_inverse_apply(phi, omega) -> tuple[float, float, float]:
+def left_jacobian_inverse_apply(
+    phi: Sequence[float] | np.ndarray, omega: Sequence[float] | np.ndarray
+) -> tuple[float, float, float]:
     """``phi_dot`` with ``J_l(phi) phi_dot = omega``, in plain floats (the expert's per-step
     path: ``omega - phi x omega / 2 + e phi x (phi x omega)``, no 3x3 matrix).
 
@@ -130,12 +181,12 @@ def left_jacobian_inverse_apply(phi, omega) -> tuple[float, float, float]:
     return (wx - 0.5 * cx + e * ccx, wy - 0.5 * cy + e * ccy, wz - 0.5 * cz + e * ccz)
 
 
-def angular_velocity(phi, phi_dot) -> np.ndarray:
+def angular_velocity(phi: ArrayLike, phi_dot: ArrayLike) -> np.ndarray:
     """World angular velocity ``J_l(phi) phi_dot``."""
     return left_jacobian(phi) @ np.asarray(phi_dot, dtype=float)
 
 
-def angular_acceleration(phi, phi_dot, phi_ddot) -> np.ndarray:
+def angular_acceleration(phi: ArrayLike, phi_dot: ArrayLike, phi_ddot: ArrayLike) -> np.ndarray:
     """``omega_dot = J_l phi_ddot + (d/dt J_l) phi_dot``.
 
     ``(d/dt J_l) phi_dot = (A'/theta)(phi.phi_dot)(phi x phi_dot)
@@ -153,38 +204,19 @@ def angular_acceleration(phi, phi_dot, phi_ddot) -> np.ndarray:
     return j @ pdd + da * dot * c1 + db * dot * np.cross(phi, c1) + b * np.cross(pd, c1)
 
 
-def rotvec_to_quat(phi) -> np.ndarray:
+def rotvec_to_quat(phi: ArrayLike) -> np.ndarray:
     """Quaternion ``(x, y, z, w)`` of the rotation vector ``phi`` (any length)."""
     return Rotation.from_rotvec(np.asarray(phi, dtype=float)).as_quat()
 
 
-def quat_to_rotvec(quat) -> np.ndarray:
+def quat_to_rotvec(quat: ArrayLike) -> np.ndarray:
     """Principal rotation vector (``|phi| <= pi``) of a quaternion ``(x, y, z, w)``."""
     return Rotation.from_quat(np.asarray(quat, dtype=float)).as_rotvec()
 
 
-def unwrap_rotvec(phi_new, phi_prev) -> np.ndarray:
-    """The representative ``phi_new + 2 pi n axis`` of the same rotation closest to ``phi_prev``.
-
-    Keeps a tracked deviation continuous through ``|phi| = pi`` (somersaults). For the identity
-    the axis is taken from ``phi_prev``.
-    """
-    phi_new = np.asarray(phi_new, dtype=float)
-    prev = np.asarray(phi_prev, dtype=float)
-    theta = float(np.linalg.norm(phi_new))
-    if theta < 1e-12:
-        pn = float(np.linalg.norm(prev))
-        if pn == 0.0:
-            return phi_new.copy()
-        n = round(pn / _TWO_PI)
-        return phi_new + (n * _TWO_PI / pn) * prev
-    axis = phi_new / theta
-    n = round((float(axis @ prev) - theta) / _TWO_PI)
-    # the same rotation is also -axis (2 pi - theta): both families are theta + 2 pi n on axis
-    return axis * (theta + n * _TWO_PI)
-
-
-def orientation_deviation(current: Rotation, goal: Rotation, phi_prev=None) -> np.ndarray:
+def orientation_deviation(
+    current: Rotation, goal: Rotation, phi_prev: Sequence[float] | None = None
+) -> np.ndarray:
     """``phi = Log(R_current R_goal^T)``, unwrapped against ``phi_prev`` when given."""
     phi = (current * goal.inv()).as_rotvec()
-    return phi if phi_prev is None else unwrap_rotvec(phi, phi_prev)
+    return phi if phi_prev is None else np.array(quaternion.unwrap_rotvec(phi, phi_prev))

@@ -26,19 +26,29 @@ from __future__ import annotations
 
 import bisect
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
-from sgc_env.paper.frames import C_HIGH, C_LOW, K_MIN, FrameCourse, course_end_velocity
+from sgc_env.paper.end_rules import DEFAULT_END_RULE, END_RULES
+from sgc_env.paper.frames import (
+    C_HIGH,
+    C_LOW,
+    K_MIN,
+    EndVelocity,
+    FrameCourse,
+    course_end_velocity,
+)
 from sgc_env.paper.frames import solve_course_in_frame as _solve_in_frame
 from sgc_env.paper.orientation import (
     angular_acceleration,
-    course_pieces,
     left_jacobian,
     left_jacobian_inverse_apply,
+    split_rotation,
 )
 
 __all__ = [
@@ -53,7 +63,7 @@ __all__ = [
 ]
 
 
-def _vec(value, size: int, where: str, name: str) -> np.ndarray:
+def _vec(value: ArrayLike, size: int, where: str, name: str) -> np.ndarray:
     a = np.asarray(value, dtype=float)
     if a.shape != (size,):
         raise ValueError(f"{where}: {name} must have shape ({size},), got {a.shape}")
@@ -64,7 +74,7 @@ def _vec(value, size: int, where: str, name: str) -> np.ndarray:
     return a
 
 
-def _quat(value, where: str, name: str) -> Rotation:
+def _quat(value: ArrayLike, where: str, name: str) -> Rotation:
     q = _vec(value, 4, where, name)
     if float(np.linalg.norm(q)) < 1e-12:
         raise ValueError(f"{where}: {name} quaternion has zero norm")
@@ -103,19 +113,33 @@ class OrientationGoal:
 
 @dataclass(frozen=True)
 class PlanOptions:
-    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there)."""
+    """The k-rule constants of ``sgc_env.paper.frames`` (defaults documented there), the
+    end-velocity rule of interior goals (``"tangent"``, the default, or ``"paper"``: eqs.
+    12-14) and the control grid split somersaults are timed on."""
 
     c_low: float = C_LOW
     c_high: float = C_HIGH
     k_min: float = K_MIN
+    end_rule: str = DEFAULT_END_RULE
+    control_frequency: int | None = None
+    """Time a split somersault's sub-courses on this control grid, as the env does (None:
+    evenly in continuous time)."""
 
     def __post_init__(self) -> None:
+        if self.control_frequency is not None and not self.control_frequency > 0:
+            raise ValueError(
+                f"options: control_frequency must be > 0, got {self.control_frequency!r}"
+            )
         if not 0.8 < self.c_low:
             raise ValueError(f"options: c_low must be > 0.8 (paper eq. 12), got {self.c_low!r}")
         if not 0.0 < self.c_high < 1.0:
             raise ValueError(f"options: c_high must be in (0, 1) (eq. 13), got {self.c_high!r}")
         if not 0.0 < self.k_min <= 1.0:
             raise ValueError(f"options: k_min must be in (0, 1], got {self.k_min!r}")
+        if self.end_rule not in END_RULES:
+            raise ValueError(
+                f"options: end_rule must be one of {list(END_RULES)}, got {self.end_rule!r}"
+            )
 
 
 @dataclass(frozen=True)
@@ -128,7 +152,7 @@ class CourseDiagnostics:
     index: int
     t_start: float
     t_end: float
-    branches: tuple[str, str, str]
+    branches: tuple[str, ...]
     k: np.ndarray
     turn_angle: float
     within_paper_assumption: bool
@@ -180,8 +204,15 @@ class BodyPlan:
     """Result of :func:`plan_body`. ``sample(t)`` for ``t >= 0``; ``courses`` diagnostics."""
 
     def __init__(
-        self, initial, orient_goals, goal_rotations, orient_track, pos_goals, pos_track, courses
-    ):
+        self,
+        initial: tuple[np.ndarray, Rotation, np.ndarray, np.ndarray],
+        orient_goals: list[Rotation],
+        goal_rotations: list[Rotation],
+        orient_track: _Track | None,
+        pos_goals: list[tuple[np.ndarray, np.ndarray]],
+        pos_track: _Track | None,
+        courses: list[CourseDiagnostics],
+    ) -> None:
         self._x0 = initial[0]
         self._r0 = initial[1]
         self._v0 = initial[2]
@@ -207,6 +238,33 @@ class BodyPlan:
             return rot, phi_dot, np.zeros(3)
         omega = left_jacobian(phi) @ phi_dot
         return rot, omega, angular_acceleration(phi, phi_dot, phi_ddot)
+
+    def deviations(
+        self, t: np.ndarray, track: str = "position"
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Planned ``(D, D', D'')`` of one track at an array of times, each ``t.shape + (3,)``:
+        the tracked point's deviation from its nail (``"position"``, world frame) or ``phi``
+        (``"orientation"``). One vectorised evaluation per course, where ``sample`` costs
+        about 0.5 ms a call: what a feasibility check on every reset can afford. A course owns
+        ``(t_start, t_end]``; after the track's last goal the deviation moves on with the
+        track's end velocity; zeros for a body without that track.
+        """
+        if track not in ("position", "orientation"):
+            raise ValueError(f"track must be 'position' or 'orientation', got {track!r}")
+        tr = self._pos if track == "position" else self._orient
+        t = np.asarray(t, float)
+        d, v, a = (np.zeros(t.shape + (3,)) for _ in range(3))
+        if tr is None:
+            return d, v, a
+        index = np.searchsorted(tr.ends, t, side="left")
+        for i, course in enumerate(tr.courses):
+            mask = index == i
+            if mask.any():
+                d[mask], v[mask], a[mask] = course.evaluate(t[mask] - tr.starts[i])
+        after = index == len(tr.courses)
+        v[after] = tr.end_velocity
+        d[after] = np.multiply.outer(t[after] - tr.ends[-1], tr.end_velocity)
+        return d, v, a
 
     def sample(self, t: float) -> PlanSample:
         """Planned state at absolute time ``t`` (seconds, ``t >= 0``)."""
@@ -251,13 +309,19 @@ def _check_times(times: Sequence[float], kind: str) -> list[float]:
     return out
 
 
-def _orientation_courses(r0, goals, times):
+def _orientation_courses(
+    r0: Rotation,
+    goals: Sequence[OrientationGoal],
+    times: Sequence[float],
+    control_frequency: int | None = None,
+) -> tuple[list[tuple[Rotation, np.ndarray, float, int]], list[Rotation]]:
     """(goal rotation, phi at the course start, end time, goal index) per course, and the
     rotation each goal reaches.
 
     A relative rotation longer than ``MAX_COURSE_ROTATION`` becomes equal sub-rotations about
-    its axis, evenly timed, as in the env: a course starting on ``|phi| = 2 pi`` could not
-    carry the angular velocity across its axis.
+    its axis (:func:`~sgc_env.paper.orientation.split_rotation`, the env's splitter): a course
+    starting on ``|phi| = 2 pi`` could not carry the angular velocity across its axis. With a
+    ``control_frequency`` the sub-courses end on the env's ticks.
     """
     out, reached = [], []
     prev, t_prev = r0, 0.0
@@ -266,26 +330,34 @@ def _orientation_courses(r0, goals, times):
         if (g.orientation is None) == (g.relative_rotation is None):
             raise ValueError(f"{where}: give exactly one of orientation and relative_rotation")
         if g.relative_rotation is None:
-            goal = _quat(g.orientation, where, "orientation")
+            goal = _quat(cast(np.ndarray, g.orientation), where, "orientation")  # checked above
             out.append((goal, (prev * goal.inv()).as_rotvec(), times[i], i))
             prev = goal
         else:
             rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
-            m = course_pieces(rel)
-            for j in range(1, m + 1):
-                prev = Rotation.from_rotvec(rel / m) * prev
-                end = times[i] if j == m else t_prev + (times[i] - t_prev) * j / m
-                out.append((prev, -rel / m, end, i))
+            for step, end in split_rotation(rel, t_prev, times[i], control_frequency, where):
+                prev = Rotation.from_rotvec(step) * prev
+                out.append((prev, -np.array(step), end, i))
         reached.append(prev)
         t_prev = times[i]
     return out, reached
 
 
-def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
-    pieces, reached = _orientation_courses(r0, goals, times)
+def _plan_orientation(
+    r0: Rotation,
+    w0: np.ndarray,
+    goals: Sequence[OrientationGoal],
+    times: Sequence[float],
+    end_w: np.ndarray | None,
+    opts: PlanOptions,
+    diags: list[CourseDiagnostics],
+) -> tuple[list[Rotation], list[Rotation], _Track]:
+    pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
-    courses, t_prev, phi_dot = [], 0.0, np.array(left_jacobian_inverse_apply(starts[0], w0))
+    courses: list[Any] = []
+    t_prev = 0.0
+    phi_dot: np.ndarray = np.array(left_jacobian_inverse_apply(starts[0], w0))
     for i, phi0 in enumerate(starts):
         T = ends[i] - t_prev
         last = i == len(starts) - 1
@@ -293,7 +365,7 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
         v_end, info = course_end_velocity(
             phi0, nxt, T, None if last else ends[i + 1] - ends[i],
             end_velocity=end_w if last else None,
-            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min,
+            c_low=opts.c_low, c_high=opts.c_high, k_min=opts.k_min, rule=opts.end_rule,
         )  # fmt: skip
         course = _solve_in_frame(info.frame, phi0, phi_dot, T, v_end)
         courses.append(course)
@@ -307,7 +379,9 @@ def _plan_orientation(r0, w0, goals, times, end_w, opts, diags):
     return [goal for goal, _, _, _ in pieces], reached, track
 
 
-def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
+def _diag(
+    track: str, i: int, t0: float, t1: float, course: FrameCourse, info: EndVelocity
+) -> CourseDiagnostics:
     return CourseDiagnostics(
         track,
         i,
@@ -321,7 +395,16 @@ def _diag(track, i, t0, t1, course: FrameCourse, info) -> CourseDiagnostics:
     )
 
 
-def _plan_position(x0, v0, orientation_at, goals, times, end_v, opts, diags):
+def _plan_position(
+    x0: np.ndarray,
+    v0: np.ndarray,
+    orientation_at: Callable[[float], tuple[Rotation, np.ndarray, np.ndarray]],
+    goals: Sequence[PositionGoal],
+    times: Sequence[float],
+    end_v: np.ndarray | None,
+    opts: PlanOptions,
+    diags: list[CourseDiagnostics],
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], _Track]:
     resolved = []
     for i, g in enumerate(goals):
         where = f"position goal {i}"
@@ -351,6 +434,7 @@ def _plan_position(x0, v0, orientation_at, goals, times, end_v, opts, diags):
             c_low=opts.c_low,
             c_high=opts.c_high,
             k_min=opts.k_min,
+            rule=opts.end_rule,
         )
         course = _solve_in_frame(info.frame, d0, dv0, T, v_end)
         courses.append(course)
@@ -368,8 +452,8 @@ def plan_body(
     position_goals: Sequence[PositionGoal],
     orientation_goals: Sequence[OrientationGoal] = (),
     *,
-    end_velocity=None,
-    end_angular_velocity=None,
+    end_velocity: ArrayLike | None = None,
+    end_angular_velocity: ArrayLike | None = None,
     options: PlanOptions | None = None,
 ) -> BodyPlan:
     """Plan one body through its goals (absolute times, the initial state is at ``t = 0``).
@@ -397,7 +481,9 @@ def plan_body(
     p_times = _check_times([g.time for g in position_goals], "position")
     o_times = _check_times([g.time for g in orientation_goals], "orientation")
     diags: list[CourseDiagnostics] = []
-    rots, goal_rots, o_track = [], [], None
+    rots: list[Rotation] = []
+    goal_rots: list[Rotation] = []
+    o_track = None
     if orientation_goals:
         rots, goal_rots, o_track = _plan_orientation(
             r0, w0, orientation_goals, o_times, end_w, opts, diags

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 __all__ = [
     "conjugate", "exp", "exp_normalized", "log", "mul", "mul_conjugate", "rotate", "to_matrix",
+    "unwrap_rotvec",
 ]  # fmt: skip
 
 Quat = tuple[float, float, float, float]
@@ -83,6 +84,32 @@ def log(q: Sequence[float]) -> Vec3:
     else:
         scale = 2.0 * math.atan2(vnorm, w) / vnorm
     return (x * scale, y * scale, z * scale)
+
+
+def unwrap_rotvec(principal: Sequence[float], reference: Sequence[float]) -> Vec3:
+    """The rotation vector of the same rotation that lies closest to ``reference`` (the one
+    unwrap of the project: env deviations, planner, expert and comparison controllers).
+
+    Same rotation = axis * (angle + 2 pi k) for any integer k (the family along ``-axis`` is
+    the same set), so a tracked deviation phi stays continuous across steps and a
+    somersault's |phi| can exceed pi. For the identity the axis is taken from ``reference``.
+    """
+    px, py, pz = principal
+    angle = math.sqrt(px * px + py * py + pz * pz)
+    rx, ry, rz = reference
+    if angle < 1e-12:
+        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
+        if rn < math.pi:
+            return (px, py, pz)
+        ux, uy, uz = rx / rn, ry / rn, rz / rn
+    else:
+        ux, uy, uz = px / angle, py / angle, pz / angle
+    s = ux * rx + uy * ry + uz * rz
+    k = round((s - angle) / (2.0 * math.pi))
+    if k == 0:
+        return (px, py, pz)
+    a = angle + 2.0 * math.pi * k
+    return (ux * a, uy * a, uz * a)
 
 
 def rotate(q: Sequence[float], v: Sequence[float]) -> Vec3:

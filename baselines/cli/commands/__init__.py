@@ -1,0 +1,1 @@
+"""The subcommands of ``sgc``, one module each (see :mod:`baselines.cli.main`)."""

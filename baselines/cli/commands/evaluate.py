@@ -16,6 +16,17 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from baselines.cli.checks import (
+    known_env_id,
+    nonneg_float,
+    nonneg_int,
+    out_dir,
+    positive_float,
+    positive_int,
+    staged_output,
+)
+from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+
 __all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
 
 #: (summary key, column title, format) of the comparison table.
@@ -31,15 +42,40 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("speed_minima_mean", "speed minima / ep", ".1f"),
     ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
     ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
+    ("force_peak_max", "peak force (N)", ".1f"),
     ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
     ("terminated", "terminated", "d"),
+)
+
+
+#: The default table, readable at 80 columns (``--wide``: :data:`SCORECARD_COLUMNS`).
+COMPACT_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("success_rate", "success", ".2f"),
+    ("position_error_max", "pos err\nmax (m)", ".1e"),
+    ("orientation_error_max", "ori err\nmax (rad)", ".1e"),
+    ("position_closest_offset_abs_max", "offset\nmax (s)", ".3f"),
+)
+
+#: Per-goal table of a single pair: (row key, full title, compact title, format).
+GOAL_TABLE_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
+    ("body", "body", "body", "d"),
+    ("goal", "goal", "goal", "d"),
+    ("time", "time", "time", ".3f"),
+    ("position_error", "position_error", "pos err", ".2e"),
+    ("orientation_error", "orientation_error", "ori err", ".2e"),
+    ("closest_approach_offset", "closest_approach_offset", "closest", "+.3f"),
+    ("entry_offset", "entry_offset", "entry", "+.3f"),
+    ("success", "success", "ok", "s"),
 )
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--policy", action="append", metavar="SPEC",
-        help="expert | dynamic-constraints | minimum-jerk | random | path to an SB3 .zip; "
+        help="expert | expert-paper | dynamic-constraints | minimum-jerk | random | path to an "
+        "SB3 .zip; "
         "repeat or comma-separate for a comparison (default: expert)",
     )  # fmt: skip
     parser.add_argument(
@@ -47,16 +83,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
-    parser.add_argument("--episodes", type=int, default=5, help="episodes per pair (default 5)")
-    parser.add_argument("--seed", type=int, default=1000, help="episode k uses seed + k")
-    parser.add_argument("--out", type=Path, default=None, help="output folder (see above)")
-    parser.add_argument("--tolerance-position", type=float, default=0.02, metavar="M")
-    parser.add_argument("--tolerance-orientation", type=float, default=0.05, metavar="RAD")
     parser.add_argument(
-        "--tolerance-time", type=float, default=None, metavar="S",
+        "--episodes", type=positive_int, default=5, help="episodes per pair"
+    )
+    parser.add_argument(
+        "--seed", type=nonneg_int, default=EVAL_SEED,
+        help="episode k uses seed + k",
+    )  # fmt: skip
+    parser.add_argument("--out", type=out_dir, default=None, help="output folder (see above)")
+    parser.add_argument(
+        "--tolerance-position", type=positive_float, default=POSITION_TOLERANCE, metavar="M",
+        help="success: position error at the goal's tick within this",
+    )  # fmt: skip
+    parser.add_argument(
+        "--tolerance-orientation", type=positive_float, default=ORIENTATION_TOLERANCE,
+        metavar="RAD", help="success: orientation error at the goal's tick within this",
+    )  # fmt: skip
+    parser.add_argument(
+        "--tolerance-time", type=nonneg_float, default=None, metavar="S",
         help="success time tolerance (default: one control step)",
     )  # fmt: skip
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    parser.add_argument(
+        "--wide", action="store_true",
+        help="print every scorecard column (default: a compact table that fits 80 columns)",
+    )  # fmt: skip
     parser.add_argument(
         "--reward", default=None, metavar="MODE",
         help="the env's reward mode (gym.make(id, reward=MODE): schedule, distance, sparse); "
@@ -108,31 +159,43 @@ def markdown_table(summaries: Sequence[Mapping[str, Any]]) -> str:
     return "\n".join([head, rule, *body]) + "\n"
 
 
-def _rich_table(summaries: Sequence[Mapping[str, Any]], title: str) -> Any:
+def _table(title: str, wide: bool) -> Any:
+    from rich import box
     from rich.table import Table
 
-    table = Table(title=title)
-    for _, name, fmt in SCORECARD_COLUMNS:
-        table.add_column(name, justify="left" if fmt == "s" else "right")
+    if wide:
+        return Table(title=title, box=box.SQUARE)
+    return Table(title=title, box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
+
+
+def _rich_table(summaries: Sequence[Mapping[str, Any]], title: str, wide: bool = False) -> Any:
+    table = _table(title, wide)
+    columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
+    for _, name, fmt in columns:
+        text = fmt == "s"
+        table.add_column(name, justify="left" if text else "right", overflow="fold")
     for s in summaries:
-        table.add_row(*(_format(s.get(k), f) for k, _, f in SCORECARD_COLUMNS))
+        table.add_row(*(_format(s.get(k), f) for k, _, f in columns))
     return table
 
 
-def _goal_table(rows: Sequence[Mapping[str, Any]], limit: int = 40) -> Any:
-    from rich.table import Table
-
-    table = Table(title="episode 0, per goal")
-    columns = (
-        ("body", "d"), ("goal", "d"), ("time", ".3f"), ("position_error", ".2e"),
-        ("orientation_error", ".2e"), ("closest_approach_offset", "+.3f"),
-        ("entry_offset", "+.3f"), ("success", "s"),
-    )  # fmt: skip
-    for name, _ in columns:
-        table.add_column(name, justify="right")
+def _goal_table(rows: Sequence[Mapping[str, Any]], wide: bool = False, limit: int = 40) -> Any:
+    table = _table("episode 0, per goal", wide)
+    for _, full, short, _ in GOAL_TABLE_COLUMNS:
+        table.add_column(full if wide else short, justify="right")
     for row in [r for r in rows if r["episode"] == 0][:limit]:
-        table.add_row(*(_format(row[name], fmt) for name, fmt in columns))
+        table.add_row(*(_format(row[key], fmt) for key, _, _, fmt in GOAL_TABLE_COLUMNS))
     return table
+
+
+def _goals_met_line(summaries: Sequence[Mapping[str, Any]]) -> str:
+    """Goals met per policy, summed over the envs: the comparison in one line."""
+    met: dict[str, list[int]] = {}
+    for s in summaries:
+        counts = met.setdefault(str(s["policy"]), [0, 0])
+        counts[0] += int(s.get("goals_met", 0))
+        counts[1] += int(s.get("n_goals", 0))
+    return "goals met: " + ", ".join(f"{p} {m}/{n}" for p, (m, n) in met.items())
 
 
 def _write_pair(result: Any, out: Path, plots: bool) -> None:
@@ -153,15 +216,12 @@ def _write_pair(result: Any, out: Path, plots: bool) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
-
+    from baselines.cli.console import make_console, summary_line
     from baselines.evaluation import evaluate, json_ready
     from baselines.policies import policy_labels
     from sgc_env.metrics import Tolerances
 
-    console = Console()
-    if not console.is_terminal:
-        console = Console(width=200)
+    console = make_console(args.wide)
     try:
         policies = _split(args.policy, "expert")
         labels = policy_labels(policies)
@@ -169,38 +229,44 @@ def run(args: argparse.Namespace) -> int:
         tolerances = Tolerances(
             args.tolerance_position, args.tolerance_orientation, args.tolerance_time
         )
+        for env_id in envs:
+            known_env_id(env_id)
     except ValueError as exc:
         print(f"sgc evaluate: error: {exc}", file=sys.stderr)
         return 2
     single = len(policies) == 1 and len(envs) == 1
-    summaries = []
-    for env_id in envs:
-        for spec, label in zip(policies, labels, strict=True):
-            if single:
-                out = args.out or Path("runs/evaluate") / env_id / label
-            else:
-                out = (args.out or Path("runs/evaluate")) / env_id / label
-            try:
-                result = evaluate(
-                    spec, env_id, args.episodes, args.seed, tolerances=tolerances, label=label,
-                    env_kwargs=None if args.reward is None else {"reward": args.reward},
-                )  # fmt: skip
-            except ValueError as exc:
-                print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-                return 2
-            _write_pair(result, out, not args.no_plots)
-            summaries.append(result.summary)
-            if single:
-                console.print(_goal_table(result.rows))
-            console.print(f"[dim]{env_id} / {label}: wrote {out}[/dim]")
-    title = f"{args.episodes} episode(s) from seed {args.seed}"
-    console.print(_rich_table(summaries, title))
-    if not single:
+    if single:
+        root = args.out or Path("runs/evaluate") / envs[0] / labels[0]
+    else:
         root = args.out or Path("runs/evaluate")
-        root.mkdir(parents=True, exist_ok=True)
-        (root / "scorecard.json").write_text(
-            json.dumps(json_ready(summaries), indent=2, allow_nan=False) + "\n"
-        )
-        (root / "scorecard.md").write_text(markdown_table(summaries))
-        console.print(f"[dim]wrote {root / 'scorecard.md'} and scorecard.json[/dim]")
+    summaries = []
+    # Written next to the output folder and moved in at the end: an interrupted run leaves
+    # the earlier results whole.
+    with staged_output(root) as stage:
+        for env_id in envs:
+            for spec, label in zip(policies, labels, strict=True):
+                folder = Path() if single else Path(env_id) / label
+                try:
+                    result = evaluate(
+                        spec, env_id, args.episodes, args.seed, tolerances=tolerances,
+                        label=label,
+                        env_kwargs=None if args.reward is None else {"reward": args.reward},
+                    )  # fmt: skip
+                except ValueError as exc:
+                    print(f"sgc evaluate: error: {exc}", file=sys.stderr)
+                    return 2
+                _write_pair(result, stage / folder, not args.no_plots)
+                summaries.append(result.summary)
+                if single:
+                    console.print(_goal_table(result.rows, args.wide))
+                console.print(f"[dim]{env_id} / {label}: done, goes to {root / folder}[/dim]")
+        if not single:
+            (stage / "scorecard.json").write_text(
+                json.dumps(json_ready(summaries), indent=2, allow_nan=False) + "\n"
+            )
+            (stage / "scorecard.md").write_text(markdown_table(summaries))
+    title = f"{args.episodes} episode(s) from seed {args.seed}"
+    console.print(_rich_table(summaries, title, args.wide))
+    console.print(f"[dim]wrote {root}[/dim]")
+    console.print(summary_line(summaries[0]) if single else _goals_met_line(summaries))
     return 0

@@ -17,6 +17,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from baselines.cli.checks import nonneg_int, out_dir
+
 __all__ = ["add_arguments", "make_env", "run"]
 
 
@@ -24,12 +26,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     source = parser.add_mutually_exclusive_group()
     source.add_argument("--scenario", metavar="NAME|YAML", help="built-in name or YAML file")
     source.add_argument("--env", metavar="ID", help="env id whose seeded scenario to roll out")
-    parser.add_argument("--seed", type=int, default=0, help="reset seed (default 0)")
+    parser.add_argument("--seed", type=nonneg_int, default=0, help="reset seed (default 0)")
     parser.add_argument(
         "--policy", default="expert", metavar="SPEC",
         help="expert | dynamic-constraints | minimum-jerk | random | SB3 .zip (default expert)",
     )  # fmt: skip
-    parser.add_argument("--out", type=Path, default=None, help="output folder")
+    parser.add_argument("--out", type=out_dir, default=None, help="output folder")
     parser.add_argument("--video", action="store_true", help="also write rollout.mp4")
     parser.add_argument(
         "--no-compare", action="store_true",
@@ -49,8 +51,7 @@ def make_env(scenario: str | None, env_id: str | None, render: bool) -> tuple[An
         loaded = sgc_env.load_scenario(scenario)
         return SGCEnv(scenario=loaded, render_mode=mode), loaded.name
     env_id = env_id or "SGCPoint-v0"
-    if env_id not in gym.registry:
-        raise ValueError(f"env: unknown environment {env_id!r}; SGC ids: {list(sgc_env.ENV_IDS)}")
+    sgc_env.check_env_id(env_id, "env")
     return gym.make(env_id, render_mode=mode), env_id
 
 

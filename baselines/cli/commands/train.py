@@ -3,11 +3,22 @@
 from __future__ import annotations
 
 import argparse
-import json
+import math
 import shlex
 import sys
 
-from baselines.cli.commands.demos import add_push_arguments, parse_env_kwargs, push_options
+from baselines.cli.checks import (
+    UsageError,
+    env_kwargs,
+    existing_dir,
+    existing_file,
+    known_env_id,
+    nonneg_int,
+    out_dir,
+    positive_int,
+)
+from baselines.cli.commands.demos import add_push_arguments, push_options
+from sgc_env.defaults import EVAL_SEED
 
 ALGOS = ("ppo", "sac", "td3", "her")
 
@@ -15,56 +26,100 @@ ALGOS = ("ppo", "sac", "td3", "her")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--algo", required=True, choices=ALGOS, help="her = SAC + HerReplayBuffer")
     parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v0")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--timesteps", type=int, default=None, help="override n_timesteps")
+    parser.add_argument("--seed", type=nonneg_int, default=0, help="training seed")
     parser.add_argument(
-        "--out", default=None, help="run folder: tb/, checkpoints/, models, config.json"
-    )
+        "--timesteps", type=positive_int, default=None,
+        help="override n_timesteps (rounded up to whole rollouts, with a note)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--out", type=out_dir, default=None,
+        help="run folder: tb/, checkpoints/, models, config.json",
+    )  # fmt: skip
     parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
     parser.add_argument(
-        "--eval-freq", type=int, default=0, help="env steps between harness evaluations (0: off)"
-    )
-    parser.add_argument("--eval-episodes", type=int, default=10)
-    parser.add_argument("--eval-seed", type=int, default=10_000, help="first held-out seed")
+        "--eval-freq", type=nonneg_int, default=0,
+        help="env steps between harness evaluations (0: off)",
+    )  # fmt: skip
     parser.add_argument(
-        "--checkpoint-freq", type=int, default=0, help="env steps between checkpoints (0: off)"
+        "--eval-episodes", type=positive_int, default=10, help="episodes per evaluation"
     )
+    parser.add_argument(
+        "--eval-seed", type=nonneg_int, default=EVAL_SEED, help="first held-out seed"
+    )
+    parser.add_argument(
+        "--checkpoint-freq", type=nonneg_int, default=0,
+        help="env steps between checkpoints (0: off)",
+    )  # fmt: skip
     parser.add_argument(
         "--init", choices=("none", "bc"), default="none", help="bc: clone --demos first"
     )
-    parser.add_argument("--demos", default=None, help="npz from `sgc demos`")
-    parser.add_argument("--bc-epochs", type=int, default=30)
+    parser.add_argument("--demos", type=existing_file, default=None, help="npz from `sgc demos`")
+    parser.add_argument(
+        "--bc-epochs", type=nonneg_int, default=30, help="behaviour-cloning epochs"
+    )
     parser.add_argument(
         "--bc-log-std", type=float, default=-2.0, help="PPO exploration after cloning"
     )
     parser.add_argument(
-        "--critic-warmup", type=int, default=0,
+        "--critic-warmup", type=nonneg_int, default=0,
         help="env steps of RL with the actor frozen, so the critic learns the clone first",
     )  # fmt: skip
-    parser.add_argument("--dagger-rounds", type=int, default=0, help="DAgger rounds after cloning")
-    parser.add_argument("--dagger-episodes", type=int, default=20, help="rollouts per DAgger round")
+    parser.add_argument(
+        "--dagger-rounds", type=nonneg_int, default=0, help="DAgger rounds after cloning"
+    )
+    parser.add_argument(
+        "--dagger-episodes", type=positive_int, default=20, help="rollouts per DAgger round"
+    )
     add_push_arguments(parser)
     parser.add_argument(
-        "--hyperparams", default=None, help="folder of <algo>.yml (default: hyperparams/)"
+        "--hyperparams", type=existing_dir, default=None,
+        help="folder of <algo>.yml (default: the packaged baselines/hyperparams/)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--env-kwargs", type=env_kwargs, default=None, help="JSON dict passed to gym.make"
     )
-    parser.add_argument("--env-kwargs", default=None, help="JSON dict passed to gym.make")
-    parser.add_argument("--device", default="cpu")
-    parser.add_argument("--verbose", type=int, default=0)
+    parser.add_argument("--device", default="cpu", help="torch device")
+    parser.add_argument("--verbose", type=nonneg_int, default=0, help="SB3 verbosity (0, 1, 2)")
+
+
+def whole_rollouts(algo: str, env_id: str, timesteps: int | None, folder: str | None) -> int | None:
+    """``timesteps`` rounded up to what SB3 really trains: PPO collects whole rollouts of
+    ``n_steps`` per env, the off-policy algorithms one step per env at a time."""
+    if not timesteps:
+        return timesteps
+    from baselines.agents.hyperparams import load_hyperparams
+
+    hp = load_hyperparams(algo, env_id, folder)
+    chunk = hp.n_envs * (int(hp.algo_kwargs.get("n_steps", 2048)) if algo == "ppo" else 1)
+    return math.ceil(timesteps / chunk) * chunk
 
 
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.train import TrainConfig, train
+    from baselines.cli.console import summary_line
 
-    env_kwargs = parse_env_kwargs(args.env_kwargs)
+    known_env_id(args.env)
+    if args.init == "bc" and args.demos is None:
+        raise UsageError("--init bc needs --demos (an npz from `sgc demos`)")
+    timesteps = args.timesteps
+    try:
+        timesteps = whole_rollouts(args.algo, args.env, args.timesteps, args.hyperparams)
+    except ValueError:
+        pass  # train() reports a bad algo, env or hyperparameter file with its own message
+    if timesteps != args.timesteps:
+        print(
+            f"note: --timesteps {args.timesteps} rounds up to {timesteps} "
+            f"({args.algo} trains whole rollouts: n_envs x n_steps)"
+        )
     pushes = {f"push_{key}": value for key, value in push_options(args).items()}
     cfg = TrainConfig(
-        algo=args.algo, env_id=args.env, seed=args.seed, timesteps=args.timesteps,
+        algo=args.algo, env_id=args.env, seed=args.seed, timesteps=timesteps,
         out=args.out, progress=args.progress, eval_freq=args.eval_freq,
         eval_episodes=args.eval_episodes, eval_seed=args.eval_seed, init=args.init,
         demos=args.demos, bc_epochs=args.bc_epochs, bc_log_std=args.bc_log_std,
         critic_warmup=args.critic_warmup,
         dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
-        hyperparams_dir=args.hyperparams, env_kwargs=env_kwargs, device=args.device,
+        hyperparams_dir=args.hyperparams, env_kwargs=args.env_kwargs or {}, device=args.device,
         checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
         command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip
@@ -75,8 +130,15 @@ def run(args: argparse.Namespace) -> int:
     )
     if result.bc:
         print(f"bc: loss {result.bc['loss_before']:.4g} -> {result.bc['loss_after']:.4g}")
-    if result.evaluations:
-        print(f"last evaluation: {json.dumps(result.evaluations[-1], sort_keys=True)}")
     if result.model_path is not None:
         print(f"model: {result.model_path}")
+    if result.evaluations:
+        last = result.evaluations[-1]
+        where = f"; every entry in {args.out}/evaluations.json" if args.out else ""
+        print(
+            f"evaluation at {last['timesteps']} steps ({args.eval_episodes} episodes from seed "
+            f"{args.eval_seed}{where}):\n{summary_line(last)}"
+        )
+    else:
+        print("not evaluated (add --eval-freq N to score the model with the harness)")
     return 0

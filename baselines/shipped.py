@@ -1,0 +1,44 @@
+"""Files shipped inside the package (models, hyperparameters), found through importlib.resources.
+
+They resolve the same way in a checkout and in an installed wheel, so ``sgc`` works from any
+directory. A shipped model is named in a policy spec as ``shipped:<env id>``.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from importlib.resources.abc import Traversable
+
+__all__ = ["SHIPPED_PREFIX", "hyperparams_file", "resolve_policy_spec", "shipped_models"]
+
+SHIPPED_PREFIX = "shipped:"
+
+
+def _data(folder: str) -> Traversable:
+    return resources.files("baselines") / folder
+
+
+def hyperparams_file(algo: str) -> Traversable:
+    """The packaged rl-zoo3-format file ``<algo>.yml``."""
+    return _data("hyperparams") / f"{algo}.yml"
+
+
+def shipped_models() -> dict[str, str]:
+    """Env id -> file path of each packaged model (``checkpoints/ppo_dagger_<id>.zip``)."""
+    prefix, suffix = "ppo_dagger_", ".zip"
+    return {
+        item.name[len(prefix) : -len(suffix)]: str(item)
+        for item in sorted(_data("checkpoints").iterdir(), key=lambda t: t.name)
+        if item.name.startswith(prefix) and item.name.endswith(suffix)
+    }
+
+
+def resolve_policy_spec(spec: str) -> str:
+    """``shipped:<env id>`` -> the packaged model's path; any other spec unchanged."""
+    if not spec.startswith(SHIPPED_PREFIX):
+        return spec
+    env_id = spec[len(SHIPPED_PREFIX) :]
+    models = shipped_models()
+    if env_id not in models:
+        raise ValueError(f"policy: no shipped model {spec!r}; shipped: {sorted(models)}")
+    return models[env_id]

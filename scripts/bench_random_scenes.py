@@ -1,0 +1,96 @@
+"""Reset cost of the random paper scenes against their fixed ids, measured in the same run.
+
+For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
+the unwrapped env, the ratio random / fixed, how many feasibility checks (``planner_demand``
+calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
+one check, and for scale the stepping time of a full-length episode of the random id (mean
+step time under seeded random actions times the episode's steps).
+
+    .venv/bin/python scripts/bench_random_scenes.py [--resets 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import gymnasium as gym
+import numpy as np
+
+import sgc_env  # noqa: F401  (registers the ids)
+from sgc_env import random_scenarios
+from sgc_env.random_scenarios import random_scenario
+
+PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
+         ("SGCThreeRods-v0", "SGCThreeRodsRandom-v0", "three_rods"))  # fmt: skip
+
+
+def _reset_ms(env_id: str, resets: int) -> float:
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    start = time.perf_counter()
+    for seed in range(1, resets + 1):
+        env.reset(seed=seed)
+    env.close()
+    return (time.perf_counter() - start) / resets * 1e3
+
+
+def _episode_ms(env_id: str, steps: int) -> float:
+    """Mean step time under seeded random actions (resets not timed) times the steps of a
+    full-length episode (``max_steps`` of seed 0's scene)."""
+    env = gym.make(env_id).unwrapped
+    env.action_space.seed(0)
+    env.reset(seed=0)
+    length = env.max_steps
+    elapsed, done = 0.0, False
+    for _ in range(steps):
+        if done:
+            env.reset()
+        start = time.perf_counter()
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        elapsed += time.perf_counter() - start
+        done = terminated or truncated
+    env.close()
+    return elapsed / steps * length * 1e3
+
+
+def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
+    """Checks per kept scene, and the mean ms of one check."""
+    calls, seconds = [0], [0.0]
+    check = random_scenarios.planner_demand
+
+    def counted(scenario, *args, **kwargs):
+        calls[0] += 1
+        start = time.perf_counter()
+        out = check(scenario, *args, **kwargs)
+        seconds[0] += time.perf_counter() - start
+        return out
+
+    random_scenarios.planner_demand = counted
+    try:
+        rng = np.random.default_rng(0)
+        for _ in range(scenes):
+            random_scenario(rng, family)
+    finally:
+        random_scenarios.planner_demand = check
+    return calls[0] / scenes, seconds[0] / calls[0] * 1e3
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--resets", type=int, default=20)
+    args = parser.parse_args()
+    print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}"
+          f" {'episode ms':>11s}")  # fmt: skip
+    for fixed, random_id, family in PAIRS:
+        base = _reset_ms(fixed, args.resets)
+        drawn = _reset_ms(random_id, args.resets)
+        draws, check_ms = _draws_per_scene(family, args.resets)
+        episode = _episode_ms(random_id, 2000)
+        print(f"{fixed:24s} {base:9.2f}")
+        print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
+              f" {episode:11.1f}")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

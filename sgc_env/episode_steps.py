@@ -1,0 +1,113 @@
+"""How many control steps an episode lasts: the ``max_episode_steps`` each registered id declares.
+
+The env truncates by itself at the last goal's tick plus ``scenario.margin``; the registry's
+bound lets tools that read the spec (``TimeLimit``, ``TimeAwareObservation``, rl-zoo3) know
+it. A built-in scenario's bound equals the env's own (both truncate on the same step); a
+random-scenario id's bound covers every draw of its preset, so its TimeLimit never cuts an
+episode short of the env's own truncation. The bound is for the registered arguments: a
+longer scenario (``scenario=``, ``reset(options={"scenario": ...})``, a higher
+``control_frequency``) would be cut short silently, so :class:`EpisodeLengthCheck` (the
+outermost registered wrapper) turns that into a ``ValueError`` at reset.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from typing import Any
+
+import gymnasium as gym
+import yaml
+
+from sgc_env.random_intercept import RandomInterceptConfig
+from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig, SceneFamily
+from sgc_env.random_three_rods import RandomThreeRodsConfig
+from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
+from sgc_env.three_rods import EMBED_DURATION, ROD_SPECS
+
+__all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
+
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def scenario_steps(scenario: Scenario) -> int:
+    """Steps of an episode of ``scenario``: its last goal's tick plus the margin's ticks.
+
+    The same count as ``SGCEnv.max_steps``. An unresolved scenario is resolved only when a
+    body's last goal has no time of its own (routing places untimed goals before timed ones).
+    """
+    if any(b.goals and b.goals[-1].time is None for b in scenario.bodies):
+        scenario = resolve_scenario(scenario)
+    f = scenario.control_frequency
+    times = [float(g.time) for b in scenario.bodies for g in b.goals if g.time is not None]
+    return max(round(t * f) for t in times) + math.ceil(scenario.margin * f - 1e-9)
+
+
+def random_steps_bound(config: SceneFamily | str) -> int:
+    """Most steps an episode of a random-scenario preset or family can last (every draw)."""
+    cfg = PRESETS[config] if isinstance(config, str) else config
+    f = cfg.control_frequency
+    if isinstance(cfg, RandomInterceptConfig):  # the meeting is the last goal
+        return math.ceil(cfg.meeting_time[1] * f) + math.ceil(cfg.margin * f - 1e-9)
+    if isinstance(cfg, RandomThreeRodsConfig):
+        # each rod's last goal: its embed, EMBED_DURATION after a hit time drawn within
+        # hit_time_change of the paper's; the margin is the builder's (as in three_rods.yaml)
+        last = max(spec.hit_time for spec in ROD_SPECS) + cfg.hit_time_change + EMBED_DURATION
+        margin = _builtin("three_rods").margin
+        return math.ceil(last * f) + 1 + math.ceil(margin * f - 1e-9)
+    return _courses_bound(cfg)
+
+
+def _courses_bound(cfg: RandomScenarioConfig) -> int:
+    """Mirrors :func:`~sgc_env.random_scenarios.random_scenario`: a course of length ``L`` is
+    flown at no less than ``min(speed_low, cap)``, where ``cap`` (the speed the force budget
+    allows after a course flown at ``v_prev``) grows with ``L`` slower than ``L`` and falls
+    with ``v_prev``; so ``L / speed`` is largest for the longest course after the fastest one.
+    """
+    f = cfg.control_frequency
+    accel_budget = 0.9 * (cfg.force_limit / cfg.mass - 9.81)
+    length, v_prev = cfg.spacing[1], cfg.speed[1]
+    cap = 0.5 * (-v_prev + math.sqrt(v_prev**2 + 4 * accel_budget * length / _ACCEL_FACTOR))
+    slowest = min(cfg.speed[0], cap)
+    course = max(6, math.ceil(length / slowest * f + 1e-6))
+    return cfg.n_goals[1] * course + math.ceil(cfg.margin * f - 1e-9)
+
+
+def registered_steps(kwargs: dict[str, Any]) -> int:
+    """``max_episode_steps`` for an id registered with these ``SGCEnv`` keyword arguments."""
+    if kwargs.get("random_scenario") is not None:
+        return random_steps_bound(kwargs["random_scenario"])
+    return scenario_steps(_builtin(kwargs["scenario"]))
+
+
+def _builtin(name: str) -> Scenario:
+    """A built-in scenario as written (validated, not resolved: cheap enough for import)."""
+    text = (resources.files("sgc_env") / "scenarios" / f"{name}.yaml").read_text()
+    return scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name)
+
+
+class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Refuses, at reset, an episode that the registered ``TimeLimit`` would end too early.
+
+    Only the registry's own bound is checked: a ``max_episode_steps`` passed to ``gym.make``
+    is the caller's choice and is left alone.
+    """
+
+    def __init__(self, env: gym.Env) -> None:
+        gym.utils.RecordConstructorArgs.__init__(self)
+        gym.Wrapper.__init__(self, env)
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        result = self.env.reset(**kwargs)
+        spec, base = self.env.spec, self.env.unwrapped
+        limit = None if spec is None else spec.max_episode_steps
+        needed = int(getattr(base, "max_steps", 0))
+        if limit is not None and needed > limit and base.spec is not None:
+            registered = gym.spec(base.spec.id).max_episode_steps
+            if limit == registered:
+                raise ValueError(
+                    f"{base.spec.id}: this episode lasts {needed} steps but the registered "
+                    f"TimeLimit ends episodes after {limit}; pass max_episode_steps={needed} "
+                    "(or -1 for no TimeLimit) to gym.make"
+                )
+        return result

@@ -1,0 +1,194 @@
+"""Random three-rod scenes: the paper's demo (``sgc_env.three_rods``) with its paths, red
+balls and target times drawn from the env's ``np_random`` on every reset.
+
+Each rod's path is the cubic spline through the paper's waypoints moved by drawn offsets
+(the hit point stays on the target face); the goal counts before and after the ball, the
+pierce and hit times, the balls' velocities and where the teal rod turns its somersault are
+drawn too. Rods, balls and the target board keep their geometry, so the observation and action
+spaces are those of ``SGCThreeRods-v0`` for every draw; the limits are constants of the id
+(twice the paper scene's).
+
+Feasibility: a rod is kept only if bounds of the force and torque along its analytic plan
+(``planner_demand``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
+Planning the rods costs far more than a reset of a fixed scene (``docs/environments.md`` has
+the figures).
+``tests/test_random_scenes.py`` runs the expert inside PyBullet on the draws.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
+from sgc_env.three_rods import (
+    FORCE_LIMIT,
+    ROD_MASS,
+    ROD_SPECS,
+    TARGET_CENTER,
+    TARGET_FACE_X,
+    TARGET_HALF_EXTENTS,
+    TORQUE_LIMIT,
+    RodSpec,
+    build_three_rods,
+)
+
+__all__ = ["RandomThreeRodsConfig", "random_three_rods"]
+
+MAX_DRAWS = 1000
+SOMERSAULT_ROD = 1
+"""Index in ``ROD_SPECS`` of the rod that turns the somersault (the teal one, as in the paper)."""
+
+
+@dataclass(frozen=True)
+class RandomThreeRodsConfig:
+    """Ranges of the three-rod family around the paper's scene (``ROD_SPECS``)."""
+
+    start_spread: float = 0.3
+    waypoint_spread: float = 0.4
+    hit_spread: float = 0.6
+    samples_before: tuple[int, int] = (2, 4)
+    samples_after_change: int = 2
+    pierce_time: tuple[float, float] = (1.0, 1.4)
+    hit_time_change: float = 0.4
+    ball_speed: tuple[float, float] = (0.5, 1.2)
+    min_entry_cosine: float = 0.5
+    """The tip must enter the board within 60 degrees of its normal (the embed goal is
+    ``EMBED_DEPTH`` into the board along the path's end tangent)."""
+    force_limit: float = 2 * FORCE_LIMIT
+    torque_limit: float = 2 * TORQUE_LIMIT
+    """Twice the paper scene's limits: drawn paths bend and speed up more than the paper's
+    hand-placed ones (constants, so the action scale is the same in every episode)."""
+    demand_share: float = 0.8
+    """Largest share of each limit the plan's force and torque bounds may use: the expert's
+    per-tick wrench can exceed the continuous plan's peak by a few percent."""
+    control_frequency: int = 60
+
+    def __post_init__(self) -> None:
+        lo, hi = self.samples_before
+        if not 1 <= lo <= hi:
+            raise ValueError(f"samples_before: expected 1 <= low <= high, got {(lo, hi)}")
+        if not 0 < self.pierce_time[0] <= self.pierce_time[1]:
+            raise ValueError(f"pierce_time: expected 0 < low <= high, got {self.pierce_time}")
+        if not 0 <= self.samples_after_change < min(s.samples_after for s in ROD_SPECS):
+            raise ValueError(
+                f"samples_after_change: expected 0 <= change < every rod's samples_after, got "
+                f"{self.samples_after_change}"
+            )
+        if not 0 < self.demand_share <= 1:
+            raise ValueError(f"demand_share: expected (0, 1], got {self.demand_share}")
+        if self.force_limit <= ROD_MASS * 9.81 or self.torque_limit <= 0:
+            raise ValueError(
+                f"force_limit {self.force_limit} N must exceed the rod's weight and "
+                f"torque_limit {self.torque_limit} N m must be positive"
+            )
+
+    def draw(self, rng: np.random.Generator) -> Scenario:
+        return random_three_rods(rng, self)
+
+    def goal_counts(self) -> tuple[tuple[int, int], ...]:
+        """Fewest and most goals per rod (samples before and after the ball, and the embed)."""
+        lo, hi = self.samples_before
+        change = self.samples_after_change
+        return tuple(
+            (lo + s.samples_after - change + 1, hi + s.samples_after + change + 1)
+            for s in ROD_SPECS
+        )
+
+
+def _vec3(v: np.ndarray) -> tuple[float, float, float]:
+    x, y, z = (float(c) for c in v)
+    return x, y, z
+
+
+def _on_grid(t: float, frequency: int) -> float:
+    return round(t * frequency) / frequency
+
+
+def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfig) -> RodSpec:
+    """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault)."""
+    points = np.asarray(base.waypoints, float)
+    moved = points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)
+    moved[0] = points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)
+    hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
+    hit = points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)
+    hit[0] = TARGET_FACE_X
+    hit[1] = np.clip(hit[1], TARGET_CENTER[1] - hy, TARGET_CENTER[1] + hy)
+    hit[2] = np.clip(hit[2], TARGET_CENTER[2] - hz, TARGET_CENTER[2] + hz)
+    moved[-1] = hit
+    moved[-2][0] = min(moved[-2][0], TARGET_FACE_X - 2.0)
+    f = cfg.control_frequency
+    direction = rng.normal(size=3)
+    after = base.samples_after + int(
+        rng.integers(-cfg.samples_after_change, cfg.samples_after_change + 1)
+    )
+    return replace(
+        base,
+        waypoints=tuple(_vec3(p) for p in moved),
+        samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
+        samples_after=after,
+        hit_time=_on_grid(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
+        pierce_time=_on_grid(rng.uniform(*cfg.pierce_time), f),
+        ball_velocity=_vec3(direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)),
+        somersault_sample=None,
+    )
+
+
+def _with_somersault(rng: np.random.Generator, spec: RodSpec) -> RodSpec:
+    """The somersault in the middle third of the path after the ball, as in the paper."""
+    first = spec.samples_before + spec.samples_after // 3
+    sample = int(rng.integers(first, first + max(1, spec.samples_after // 3)))
+    return replace(spec, somersault_sample=sample)
+
+
+def random_three_rods(
+    rng: np.random.Generator, config: RandomThreeRodsConfig | None = None
+) -> Scenario:
+    """Draw one resolved, feasible three-rod scene from ``rng``.
+
+    The rods do not interact, so each is drawn on its own until it is feasible (a rejected
+    gold rod does not cost the teal and violet ones their plans)."""
+    cfg = config or RandomThreeRodsConfig()
+    rods = [_feasible_rod(rng, k, cfg) for k in range(len(ROD_SPECS))]
+    target = rods[0].props[-1]
+    return replace(
+        rods[0],
+        name="three_rods_random",
+        bodies=tuple(r.bodies[0] for r in rods),
+        props=(*(r.props[0] for r in rods), target),
+    )
+
+
+def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
+    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
+    from sgc_env.random_scenarios import planner_demand  # it draws through this module
+
+    share = cfg.demand_share
+    for _ in range(MAX_DRAWS):
+        spec = _rod_spec(rng, ROD_SPECS[k], cfg)
+        if k == SOMERSAULT_ROD:
+            spec = _with_somersault(rng, spec)
+        data = build_three_rods((spec,), name="three_rods_random")
+        data["control_frequency"] = cfg.control_frequency
+        (body,) = data["bodies"]
+        if not _enters_board(body, cfg.min_entry_cosine):
+            continue
+        body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
+        # The demand share below is the feasibility check (stricter than resolve_scenario's
+        # plan check, which would run the planner twice and raise instead of redraw).
+        scenario = resolve_scenario(scenario_from_dict(data), check_plan=False)
+        ((force, torque),) = planner_demand(scenario)
+        if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
+            return scenario
+    raise RuntimeError(
+        f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
+        "the limits"
+    )
+
+
+def _enters_board(body: dict, min_cosine: float) -> bool:
+    """The rod's last course (the embed) heads into the board steeply enough."""
+    hit, embed = (np.asarray(gl["nail"], float) for gl in body["goals"][-2:])
+    step = embed - hit
+    return bool(step[0] / np.linalg.norm(step) >= min_cosine)

@@ -1,0 +1,250 @@
+"""`sgc benchmark`: IQM and stratified bootstrap, grid checks, both backends, resume."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+from baselines.benchmark.aggregate import (  # noqa: E402
+    iqm,
+    learning_curve,
+    performance_profile,
+    stratified_bootstrap_ci,
+    summarize_metric,
+)
+from baselines.benchmark.grid import (  # noqa: E402
+    Recipe,
+    build_grid,
+    load_recipes,
+    recipes_from_algos,
+    train_command,
+)
+from baselines.cli import main as cli  # noqa: E402
+
+TINY_PPO = """
+SGCPoint-v0:
+  n_timesteps: 128
+  policy: MlpPolicy
+  n_envs: 2
+  n_steps: 64
+  batch_size: 64
+  n_epochs: 2
+  policy_kwargs: "dict(net_arch=[16])"
+"""
+
+
+@pytest.fixture()
+def tiny_hp(tmp_path: Path) -> Path:
+    folder = tmp_path / "hp"
+    folder.mkdir()
+    (folder / "ppo.yml").write_text(TINY_PPO)
+    return folder
+
+
+# ---------------------------------------------------------------- statistics
+
+
+def test_iqm_is_the_mean_of_the_middle_half() -> None:
+    assert iqm(np.arange(1.0, 9.0)) == pytest.approx(4.5)  # mean of 3, 4, 5, 6
+    assert iqm([0.0, 0.0, 0.0, 100.0]) == pytest.approx(0.0)  # outlier trimmed
+    assert iqm([0.2, 0.4, 0.9]) == pytest.approx(0.5)  # three runs: nothing to trim
+
+
+def test_bootstrap_ci_degenerate_cases() -> None:
+    assert stratified_bootstrap_ci([[0.3, 0.3, 0.3]]) == pytest.approx((0.3, 0.3))
+    assert stratified_bootstrap_ci([[0.7]]) == pytest.approx((0.7, 0.7))
+    low, high = stratified_bootstrap_ci([[0.0, 1.0]], np.mean)
+    assert low == 0.0 and high == 1.0  # resamples {0,0}, {0,1}, {1,1}: all three occur
+
+
+def test_bootstrap_is_stratified_by_task() -> None:
+    # Each task is constant, so resampling within tasks always pools three 0s and three 1s;
+    # resampling across tasks would not, and its interval would be wide.
+    strata = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]
+    assert stratified_bootstrap_ci(strata, np.mean) == pytest.approx((0.5, 0.5))
+    assert stratified_bootstrap_ci([[0.0, 0.0, 0.0, 1.0, 1.0, 1.0]], np.mean) != (0.5, 0.5)
+
+
+def test_bootstrap_matches_scipy_for_one_stratum() -> None:
+    from scipy.stats import bootstrap
+
+    x = np.random.default_rng(1).normal(size=40)
+    ours = stratified_bootstrap_ci([x], np.mean, n_resamples=20_000)
+    ref = bootstrap((x,), np.mean, method="percentile", n_resamples=20_000, random_state=2)
+    assert ours == pytest.approx(tuple(ref.confidence_interval), abs=0.03)
+
+
+def test_bootstrap_rejects_bad_input() -> None:
+    with pytest.raises(ValueError, match="non-empty"):
+        stratified_bootstrap_ci([[]])
+    with pytest.raises(ValueError, match="finite"):
+        stratified_bootstrap_ci([[1.0, np.nan]])
+
+
+def test_summarize_metric_skips_missing_values() -> None:
+    stats = summarize_metric([[0.25, None, 0.75, float("nan")]])
+    assert stats["n"] == 2 and stats["mean"] == pytest.approx(0.5)
+    assert summarize_metric([[None]])["iqm"] is None
+
+
+def test_performance_profile_counts_runs_above_tau() -> None:
+    prof = performance_profile([[0.2, 0.6, 1.0]], [0.0, 0.5, 1.0])
+    assert prof["fraction"] == pytest.approx([1.0, 2 / 3, 0.0])
+    bands = zip(prof["low"], prof["fraction"], prof["high"], strict=True)
+    assert all(lo <= f <= hi for lo, f, hi in bands)
+
+
+def test_learning_curve_uses_steps_every_run_has() -> None:
+    runs = [
+        {"curve": [{"timesteps": 10, "success_rate": 0.0}, {"timesteps": 20, "success_rate": 1.0}]},
+        {"curve": [{"timesteps": 10, "success_rate": 0.5}]},
+    ]
+    curve = learning_curve(runs)
+    assert curve["timesteps"] == [10] and curve["iqm"] == pytest.approx([0.25])
+
+
+# ---------------------------------------------------------------- grid
+
+
+def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
+    (spec,) = build_grid(recipes_from_algos(["ppo"], str(tiny_hp), {"a": 1}, 64), ["SGCPoint-v0"],
+                         [3], eval_freq=64, curve_episodes=1, eval_episodes=2)  # fmt: skip
+    command = train_command(spec.train_options(out="DIR"))
+    assert command == (f"sgc train --algo ppo --env SGCPoint-v0 --seed 3 --timesteps 64 "
+                       f"--out DIR --eval-freq 64 --eval-episodes 1 --hyperparams {tiny_hp} "
+                       "--env-kwargs '{\"a\": 1}'")  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"env_ids": ["Nope-v0"]}, "--env: unknown environment"),
+        ({"seeds": [0, 0]}, "distinct seeds"),
+        ({"seeds": []}, "distinct seeds"),
+        ({"eval_episodes": 0}, "--eval-episodes"),
+        ({"test_seed": 10_001}, "overlap"),
+        ({"recipes": [Recipe("a", "ppo"), Recipe("a", "sac")]}, "more than once"),
+        ({"recipes": []}, "give --algo or --recipes"),
+    ],
+)
+def test_bad_grid_arguments_are_named(kwargs: dict, message: str) -> None:
+    args = {"recipes": [Recipe("ppo", "ppo")], "env_ids": ["SGCPoint-v0"], "seeds": [0],
+            "eval_freq": 0, "curve_episodes": 1, "eval_episodes": 2, **kwargs}  # fmt: skip
+    with pytest.raises(ValueError, match=message):
+        build_grid(args.pop("recipes"), args.pop("env_ids"), args.pop("seeds"), **args)
+
+
+def test_recipes_file(tmp_path: Path, tiny_hp: Path) -> None:
+    path = tmp_path / "recipes.yml"
+    path.write_text(
+        "recipes:\n  - {name: tiny, algo: ppo, hyperparams: hp, timesteps: 64}\n"
+        "  - {name: clone, algo: ppo, train: {init: bc, demos: 'd/{env_id}.npz', "
+        "dagger_rounds: 2}}\n"
+    )
+    tiny, clone = load_recipes(path)
+    assert tiny.hyperparams == str(tiny_hp) and not tiny.demonstrations
+    assert clone.demonstrations
+    (spec,) = build_grid([clone], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+                         eval_episodes=1)  # fmt: skip
+    assert spec.train_options(None)["demos"] == "d/SGCPoint-v0.npz"
+    path.write_text("recipes:\n  - {algo: ppo, train: {seed: 3}}\n")
+    with pytest.raises(ValueError, match=r"recipe 0: train option\(s\) \['seed'\]"):
+        load_recipes(path)
+    path.write_text("recipes:\n  - {algo: dqn}\n")
+    with pytest.raises(ValueError, match="algo must be one of"):
+        load_recipes(path)
+
+
+def test_cli_reports_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    argv = ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "0",
+            "--out", str(tmp_path)]  # fmt: skip
+    assert cli.main(argv) == 2
+    assert "--seeds must be >= 1" in capsys.readouterr().err
+    assert cli.main([*argv[:5], "--backend", "local", "--address", "x"]) == 2
+    assert "--address is for --backend ray" in capsys.readouterr().err
+
+
+def test_a_lost_worker_is_a_failed_run_and_the_grid_goes_on() -> None:
+    from baselines.benchmark.backends import _throttled
+
+    def collect(handle: dict) -> dict:
+        if handle["run_id"] == "b":
+            raise RuntimeError("worker died")
+        return {"run_id": handle["run_id"], "status": "finished"}
+
+    started: list[str] = []
+    specs = [{"run_id": name} for name in "abc"]
+    outcomes = list(_throttled(specs, 2, dict, lambda p: (p[:1], p[1:]), collect, started.append))
+    assert started == ["a", "b", "c"]
+    assert [(o["run_id"], o["status"]) for o in outcomes] == [
+        ("a", "finished"),
+        ("b", "failed"),
+        ("c", "finished"),
+    ]
+    assert "worker died" in outcomes[1]["error"]
+
+
+# ---------------------------------------------------------------- end to end
+
+
+def _tiny_argv(out: Path, hp: Path, *extra: str) -> list[str]:
+    return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "2",
+            "--timesteps", "128", "--eval-episodes", "2", "--curve-episodes", "1",
+            "--eval-freq", "128", "--hyperparams", str(hp), "--workers", "2", "--no-plots",
+            "--out", str(out), *extra]  # fmt: skip
+
+
+_RUN_DEPENDENT = ("wall_time_s", "steps_per_s", "commands")
+
+
+def _rows(out: Path) -> list[dict]:
+    rows = json.loads((out / "leaderboard.json").read_text())["rows"]
+    return [{k: v for k, v in row.items() if k not in _RUN_DEPENDENT} for row in rows]
+
+
+def test_local_and_ray_give_the_same_leaderboard_and_resume(tmp_path: Path, tiny_hp: Path) -> None:
+    pytest.importorskip("ray")
+    local, ray_out = tmp_path / "local", tmp_path / "ray"
+    assert cli.main(_tiny_argv(local, tiny_hp)) == 0
+    assert cli.main(_tiny_argv(ray_out, tiny_hp, "--backend", "ray")) == 0
+    rows = _rows(local)
+    assert rows == _rows(ray_out)
+    (row,) = rows
+    assert row["seeds"] == [0, 1] and row["timesteps"] == [128, 128]
+    assert row["final"]["success_rate"]["n"] == 2
+    run = local / "runs" / "SGCPoint-v0" / "ppo" / "seed1"
+    for name in ("config.json", "command.txt", "final_model.zip", "best_model.zip"):
+        assert (run / name).is_file(), name
+    command = (run / "command.txt").read_text()
+    assert "--seed 1" in command and f"--out {run}" in command
+    stamp = (run / "result.json").stat().st_mtime_ns
+    assert cli.main(_tiny_argv(local, tiny_hp)) == 0  # resumed: nothing left to run
+    assert (run / "result.json").stat().st_mtime_ns == stamp
+    assert _rows(local) == rows
+
+
+def test_failed_runs_are_recorded_and_retried_on_request(
+    tmp_path: Path, tiny_hp: Path, capsys: pytest.CaptureFixture
+) -> None:
+    recipes = tmp_path / "r.yml"
+    recipes.write_text(f"recipes:\n  - {{name: clone, algo: ppo, hyperparams: {tiny_hp}, "
+                       "timesteps: 0, train: {init: bc, demos: missing.npz}}\n")  # fmt: skip
+    argv = ["benchmark", "--recipes", str(recipes), "--env", "SGCPoint-v0", "--seeds", "1",
+            "--eval-episodes", "1", "--curve-episodes", "1", "--workers", "1", "--no-plots",
+            "--out", str(tmp_path / "b")]  # fmt: skip
+    assert cli.main(argv) == 1
+    failed = tmp_path / "b" / "runs" / "SGCPoint-v0" / "clone" / "seed0" / "failed.json"
+    record = json.loads(failed.read_text())
+    assert record["status"] == "failed" and "missing.npz" in record["traceback"]
+    assert "1 failed before (skipped" not in capsys.readouterr().out
+    assert cli.main(argv) == 1
+    assert "0 to run" in capsys.readouterr().out
+    assert cli.main([*argv, "--retry-failed"]) == 1
+    assert "1 to run" in capsys.readouterr().out
+    board = json.loads((tmp_path / "b" / "leaderboard.json").read_text())
+    assert board["rows"][0]["failed_seeds"] == [0] and board["rows"][0]["seeds"] == []

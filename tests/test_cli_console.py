@@ -1,0 +1,66 @@
+"""The console at a person's terminal width: compact tables, one summary line, defaults in
+``--help``, whole rollouts announced."""
+
+from __future__ import annotations
+
+import pytest
+
+from baselines.cli.commands.train import whole_rollouts
+from baselines.cli.console import summary_line
+from baselines.cli.main import build_parser, main
+
+
+def test_evaluate_fits_80_columns(tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.setenv("COLUMNS", "80")
+    argv = ["evaluate", "--env", "SGCIntercept-v0", "--policy", "expert,dynamic-constraints",
+            "--episodes", "1", "--no-plots", "--out", str(tmp_path)]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines()) <= 80
+    assert "…" not in out  # no cell cut short
+    assert "dynamic-constraints" in out and "goals met: expert 2/2, dynamic-constraints" in out
+    assert main([*argv, "--wide"]) == 0
+    wide = capsys.readouterr().out
+    assert "SPARC track" in wide and "…" not in wide
+
+
+def test_single_pair_ends_with_one_summary_line(tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.setenv("COLUMNS", "80")
+    argv = ["evaluate", "--env", "SGCRod-v0", "--episodes", "1", "--no-plots",
+            "--out", str(tmp_path)]  # fmt: skip
+    assert main(argv) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("3/3 goals met, success 1.00, max error ") and last.endswith("rad")
+
+
+def test_summary_line_reads_flattened_histories() -> None:
+    line = summary_line({"goals_met": 0.0, "n_goals": 6.0, "success_rate": 0.0,
+                         "position_error_max": 3.1, "orientation_error_max": float("nan"),
+                         "terminated": 2.0})  # fmt: skip
+    assert line == (
+        "0/6 goals met, success 0.00, max error 3.1e+00 m, "
+        "2 episode(s) failed (left the workspace or diverged)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("algo", "asked", "trained"),
+    [("ppo", 5000, 6144), ("ppo", 2048, 2048), ("sac", 1001, 1001), ("ppo", None, None)],
+)
+def test_timesteps_round_up_to_whole_rollouts(algo, asked, trained) -> None:
+    assert whole_rollouts(algo, "SGCPoint-v0", asked, None) == trained
+
+
+def _help(command: str, capsys: pytest.CaptureFixture[str]) -> str:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args([command, "--help"])
+    return capsys.readouterr().out
+
+
+def test_help_shows_defaults(capsys) -> None:
+    evaluate = _help("evaluate", capsys)
+    assert "(default: 5)" in evaluate and "(default: 10000)" in evaluate
+    assert "(default: None)" not in evaluate and "(default: False)" not in evaluate
+    assert "(default: 0.02)" in evaluate
+    train = _help("train", capsys)
+    assert "training seed (default: 0)" in train and "(default: cpu)" in train
