@@ -71,10 +71,16 @@ class DemoResult:
     cpu_s: float = 0.0
 
 
+_EARLIER_CHILDREN = os.times().children_user + os.times().children_system
+"""Children's CPU already counted when this module loads: a shell that runs ``setup.sh && sgc
+demo`` as ``bash -c`` execs ``sgc`` in its own process, which then inherits pip's CPU time."""
+
+
 def cpu_seconds() -> float:
-    """CPU time of this process and its waited-for children (ffmpeg), user + system."""
+    """CPU time of this process and its waited-for children (ffmpeg), user + system, without
+    the children of whatever ran in this process before the command (see above)."""
     t = os.times()
-    return t.user + t.system + t.children_user + t.children_system
+    return t.user + t.system + t.children_user + t.children_system - _EARLIER_CHILDREN
 
 
 class DemoScene:
