@@ -502,6 +502,6 @@ def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
         client = left_open.unwrapped.sim.client
         assert sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert set(made) == {left_open.unwrapped, closed}
-    assert left_open.unwrapped._closed
+    assert left_open.unwrapped.sim is None and left_open.unwrapped._closed
     assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert set(close_envs) >= set(made)  # nested blocks: the autouse fixture saw them too

@@ -71,7 +71,8 @@ class DemoResult:
     cpu_s: float = 0.0
 
 
-_EARLIER_CHILDREN = os.times().children_user + os.times().children_system
+_AT_IMPORT = os.times()
+_EARLIER_CHILDREN = _AT_IMPORT.children_user + _AT_IMPORT.children_system
 """Children's CPU already counted when this module loads: a shell that runs ``setup.sh && sgc
 demo`` as ``bash -c`` execs ``sgc`` in its own process, which then inherits pip's CPU time."""
 
