@@ -1,7 +1,9 @@
 """Files shipped inside the package (models, hyperparameters), found through importlib.resources.
 
 They resolve the same way in a checkout and in an installed wheel, so ``sgc`` works from any
-directory. A shipped model is named in a policy spec as ``shipped:<env id>``.
+directory. A shipped model is named in a policy spec as ``shipped:<env id>`` (the BC+DAgger
+model of that id) or ``shipped:<file stem>`` (any model, e.g.
+``shipped:ppo_schedule_SGCPoint-v0``).
 """
 
 from __future__ import annotations
@@ -9,7 +11,13 @@ from __future__ import annotations
 from importlib import resources
 from importlib.resources.abc import Traversable
 
-__all__ = ["SHIPPED_PREFIX", "hyperparams_file", "resolve_policy_spec", "shipped_models"]
+__all__ = [
+    "SHIPPED_PREFIX",
+    "hyperparams_file",
+    "resolve_policy_spec",
+    "shipped_files",
+    "shipped_models",
+]
 
 SHIPPED_PREFIX = "shipped:"
 
@@ -33,12 +41,22 @@ def shipped_models() -> dict[str, str]:
     }
 
 
+def shipped_files() -> dict[str, str]:
+    """File stem -> file path of every packaged model."""
+    return {
+        item.name[: -len(".zip")]: str(item)
+        for item in sorted(_data("checkpoints").iterdir(), key=lambda t: t.name)
+        if item.name.endswith(".zip")
+    }
+
+
 def resolve_policy_spec(spec: str) -> str:
-    """``shipped:<env id>`` -> the packaged model's path; any other spec unchanged."""
+    """``shipped:<env id>`` or ``shipped:<file stem>`` -> the packaged model's path; any other
+    spec unchanged."""
     if not spec.startswith(SHIPPED_PREFIX):
         return spec
-    env_id = spec[len(SHIPPED_PREFIX) :]
-    models = shipped_models()
-    if env_id not in models:
+    name = spec[len(SHIPPED_PREFIX) :]
+    models = {**shipped_files(), **shipped_models()}
+    if name not in models:
         raise ValueError(f"policy: no shipped model {spec!r}; shipped: {sorted(models)}")
-    return models[env_id]
+    return models[name]

@@ -160,6 +160,34 @@ def test_recipes_file(tmp_path: Path, tiny_hp: Path) -> None:
         load_recipes(path)
 
 
+def test_a_recipe_runs_only_on_its_envs(tmp_path: Path) -> None:
+    (tmp_path / "hp").mkdir()
+    (tmp_path / "hp" / "ppo.yml").write_text(
+        "SGCPoint-v0: &p {n_timesteps: 64, policy: MlpPolicy}\nSGCPointGoal-v0: *p\n"
+    )
+    path = tmp_path / "recipes.yml"
+    path.write_text(
+        "recipes:\n  - {name: everywhere, algo: ppo, hyperparams: hp}\n"
+        "  - {name: goal-only, algo: her, envs: [SGCPointGoal-v0]}\n"
+    )
+    everywhere, goal_only = load_recipes(path)
+    assert goal_only.envs == ("SGCPointGoal-v0",) and everywhere.envs == ()
+    grid = build_grid([everywhere, goal_only], ["SGCPoint-v0", "SGCPointGoal-v0"], [0, 1],
+                      eval_freq=0, curve_episodes=1, eval_episodes=1)  # fmt: skip
+    cells = [(spec.env_id, spec.recipe.name) for spec in grid]
+    assert ("SGCPoint-v0", "goal-only") not in cells
+    assert cells.count(("SGCPointGoal-v0", "goal-only")) == 2 and len(cells) == 6
+    with pytest.raises(ValueError, match="none of its envs"):
+        build_grid([goal_only], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+                   eval_episodes=1)  # fmt: skip
+    path.write_text("recipes:\n  - {algo: ppo, envs: [Nope-v0]}\n")
+    with pytest.raises(ValueError, match="recipe 0: envs"):
+        load_recipes(path)
+    path.write_text("recipes:\n  - {algo: ppo, envs: SGCPoint-v0}\n")
+    with pytest.raises(ValueError, match="envs must be a list"):
+        load_recipes(path)
+
+
 def test_cli_reports_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
     argv = ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "0",
             "--out", str(tmp_path)]  # fmt: skip

@@ -14,7 +14,12 @@ import pytest
 import sgc_env
 from baselines.agents.hyperparams import load_hyperparams
 from baselines.policies import make_policy
-from baselines.shipped import hyperparams_file, resolve_policy_spec, shipped_models
+from baselines.shipped import (
+    hyperparams_file,
+    resolve_policy_spec,
+    shipped_files,
+    shipped_models,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,6 +36,9 @@ def test_shipped_models_resolve_and_load() -> None:
     models = shipped_models()
     assert set(models) <= set(sgc_env.ENV_IDS) and "SGCPoint-v0" in models
     assert resolve_policy_spec("shipped:SGCPoint-v0") == models["SGCPoint-v0"]
+    for stem, path in shipped_files().items():
+        assert resolve_policy_spec(f"shipped:{stem}") == path
+    assert "ppo_schedule_SGCPoint-v0" in shipped_files()  # the model learned without demos
     assert resolve_policy_spec("expert") == "expert"
     env = gym.make("SGCPoint-v0")
     obs, _ = env.reset(seed=0)

@@ -43,6 +43,7 @@ class Hyperparams:
     policy: str
     n_envs: int = 1
     normalize: bool = False
+    normalize_kwargs: dict[str, Any] = field(default_factory=dict)
     noise_type: str | None = None
     noise_std: float = 0.1
     algo_kwargs: dict[str, Any] = field(default_factory=dict)
@@ -63,6 +64,10 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
         from baselines.agents.features import StandardizeObservation
 
         return StandardizeObservation
+    if short == "ScheduleFeatures":
+        from baselines.agents.schedule_features import ScheduleFeatures
+
+        return ScheduleFeatures
     if short == "HerReplayBuffer":
         from stable_baselines3 import HerReplayBuffer
 
@@ -137,6 +142,23 @@ def _learning_rate(value: Any) -> Any:
     return float(value)
 
 
+_NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward")
+
+
+def _normalize(value: Any, where: str) -> tuple[bool, dict[str, Any]]:
+    """rl-zoo3's ``normalize``: a bool, or VecNormalize kwargs as a mapping or a dict string."""
+    if isinstance(value, bool):
+        return value, {}
+    if isinstance(value, str):
+        value = parse_kwargs_string(value, "normalize")
+    if not isinstance(value, dict):
+        raise ValueError(f"{where}: normalize must be true/false or a mapping, got {value!r}")
+    unknown = sorted(set(value) - set(_NORMALIZE_KEYS))
+    if unknown:
+        raise ValueError(f"{where}: normalize: unknown keys {unknown} (known: {_NORMALIZE_KEYS})")
+    return True, dict(value)
+
+
 ALGORITHMS: tuple[str, ...] = ("ppo", "sac", "td3", "her")
 
 
@@ -184,6 +206,7 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         elif key == "replay_buffer_class" and isinstance(value, str):
             value = _resolve_name(value, key)
         kwargs[key] = value
+    normalize, normalize_kwargs = _normalize(entry.get("normalize", False), f"{path}: {env_id}")
     noise_type = entry.get("noise_type")
     if noise_type not in (None, "normal"):
         raise ValueError(f"{path}: {env_id}: noise_type must be 'normal', got {noise_type!r}")
@@ -200,7 +223,8 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         n_timesteps=n_timesteps,
         policy=str(entry["policy"]),
         n_envs=n_envs,
-        normalize=bool(entry.get("normalize", False)),
+        normalize=normalize,
+        normalize_kwargs=normalize_kwargs,
         noise_type=noise_type,
         noise_std=float(entry.get("noise_std", 0.1)),
         algo_kwargs=kwargs,

@@ -149,7 +149,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     set_random_seed(cfg.seed)
     env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs)
     if hp.normalize:
-        env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99))
+        env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
     kwargs = dict(hp.algo_kwargs)
     if cfg.init == "bc":
         from baselines.agents.features import StandardizeObservation

@@ -42,6 +42,7 @@ _OWNED = {
     "algo", "env_id", "seed", "out", "eval_freq", "eval_episodes", "eval_seed", "command",
     "progress", "verbose", "env_kwargs", "hyperparams_dir", "timesteps",
 }  # fmt: skip
+_RECIPE_FIELDS = {"name", "algo", "hyperparams", "timesteps", "env_kwargs", "train", "envs"}
 #: TrainConfig field -> ``sgc train`` flag, where the two are not spelled alike.
 _FLAGS = {"env_id": "--env", "hyperparams_dir": "--hyperparams"}
 
@@ -62,6 +63,11 @@ class Recipe:
     timesteps: int | None = None
     env_kwargs: Mapping[str, Any] = field(default_factory=dict)
     train: Mapping[str, Any] = field(default_factory=dict)
+    envs: tuple[str, ...] = ()
+    """The env ids this recipe runs on (empty: every ``--env``); e.g. HER's goal-conditioned id."""
+
+    def runs_on(self, env_id: str) -> bool:
+        return not self.envs or env_id in self.envs
 
     @property
     def demonstrations(self) -> bool:
@@ -72,7 +78,8 @@ class Recipe:
         return {
             "name": self.name, "algo": self.algo, "hyperparams": self.hyperparams,
             "timesteps": self.timesteps, "env_kwargs": dict(self.env_kwargs),
-            "train": dict(self.train), "demonstrations": self.demonstrations,
+            "train": dict(self.train), "envs": list(self.envs),
+            "demonstrations": self.demonstrations,
         }  # fmt: skip
 
 
@@ -122,6 +129,7 @@ class RunSpec:
     def from_dict(cls, data: Mapping[str, Any]) -> RunSpec:
         r = dict(data["recipe"])
         r.pop("demonstrations", None)
+        r["envs"] = tuple(r.get("envs") or ())
         return cls(
             recipe=Recipe(**r), env_id=data["env_id"], seed=int(data["seed"]),
             eval_freq=int(data["eval_freq"]), curve_episodes=int(data["curve_episodes"]),
@@ -159,7 +167,7 @@ def _recipe(entry: Any, where: str) -> Recipe:
 
     if not isinstance(entry, Mapping):
         raise ValueError(f"{where}: expected a mapping, got {type(entry).__name__}")
-    unknown = set(entry) - {"name", "algo", "hyperparams", "timesteps", "env_kwargs", "train"}
+    unknown = set(entry) - _RECIPE_FIELDS
     if unknown:
         raise ValueError(f"{where}: unknown recipe field(s) {sorted(unknown)}")
     algo = entry.get("algo")
@@ -181,7 +189,14 @@ def _recipe(entry: Any, where: str) -> Recipe:
     hyperparams = entry.get("hyperparams")
     if hyperparams is not None and not Path(hyperparams).is_dir():
         raise ValueError(f"{where}: hyperparams folder {hyperparams!r} does not exist")
-    return Recipe(name, algo, hyperparams, timesteps, dict(env_kwargs), dict(train))
+    envs = entry.get("envs") or []
+    if isinstance(envs, str) or not isinstance(envs, list):
+        raise ValueError(f"{where}: envs must be a list of env ids, got {envs!r}")
+    from sgc_env import check_env_id
+
+    for env_id in envs:
+        check_env_id(env_id, f"{where}: envs")
+    return Recipe(name, algo, hyperparams, timesteps, dict(env_kwargs), dict(train), tuple(envs))
 
 
 def load_recipes(path: str | Path) -> list[Recipe]:
@@ -265,10 +280,16 @@ def build_grid(
     for env_id in env_ids:
         check_env_id(env_id, "--env")
         for recipe in recipes:
-            load_hyperparams(recipe.algo, env_id, recipe.hyperparams)  # fails early, naming it
+            if recipe.runs_on(env_id):
+                load_hyperparams(recipe.algo, env_id, recipe.hyperparams)  # fails early, naming it
+    for recipe in recipes:
+        if not any(recipe.runs_on(e) for e in env_ids):
+            raise ValueError(f"recipe {recipe.name!r}: none of its envs {list(recipe.envs)} is "
+                             f"in --env {list(env_ids)}")  # fmt: skip
     return [
         RunSpec(r, e, s, eval_freq, curve_episodes, eval_episodes, eval_seed, test_seed)
         for e in env_ids
         for r in recipes
+        if r.runs_on(e)
         for s in seeds
     ]

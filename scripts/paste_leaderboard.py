@@ -1,0 +1,51 @@
+"""Paste a ``sgc benchmark`` leaderboard into a markdown document, between markers.
+
+The README and docs/agents.md carry the leaderboard that ``sgc benchmark`` wrote, verbatim
+(its title dropped and its env headings demoted to ``###``), between the lines
+``<!-- leaderboard:begin -->`` and ``<!-- leaderboard:end -->``, so a rerun of the benchmark
+updates them with one command::
+
+    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md README.md docs/agents.md
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+BEGIN, END = "<!-- leaderboard:begin -->", "<!-- leaderboard:end -->"
+
+
+def leaderboard_body(text: str) -> str:
+    """The leaderboard without its ``#`` title, env headings as ``###``."""
+    lines = text.strip().splitlines()
+    if not lines or not lines[0].startswith("# "):
+        raise ValueError("not a leaderboard.md of `sgc benchmark` (no '# ' title line)")
+    body = [("#" + line) if line.startswith("## ") else line for line in lines[1:]]
+    return "\n".join(body).strip()
+
+
+def paste(document: str, body: str, where: str) -> str:
+    if document.count(BEGIN) != 1 or document.count(END) != 1:
+        raise ValueError(f"{where}: needs exactly one {BEGIN} and one {END} line")
+    head, rest = document.split(BEGIN)
+    _, tail = rest.split(END)
+    return f"{head}{BEGIN}\n{body}\n{END}{tail}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("leaderboard", type=Path, help="leaderboard.md written by sgc benchmark")
+    parser.add_argument("documents", type=Path, nargs="+", help="markdown files with the markers")
+    args = parser.parse_args()
+    body = leaderboard_body(args.leaderboard.read_text())
+    for doc in args.documents:
+        try:
+            doc.write_text(paste(doc.read_text(), body, str(doc)))
+        except ValueError as exc:
+            parser.error(str(exc))
+        print(f"pasted {args.leaderboard} into {doc}")
+
+
+if __name__ == "__main__":
+    main()
