@@ -28,8 +28,8 @@ print("imports from", baselines.__file__)
 PY
 step "3/4 sgc train (one PPO rollout) from $PWD"
 "$work/venv/bin/sgc" train --algo ppo --env SGCPoint-v0 --timesteps 2048 --out train
-step "4/4 sgc evaluate: the expert and the shipped model"
-"$work/venv/bin/sgc" evaluate --env SGCPoint-v0 --policy expert,shipped:SGCPoint-v0 \
+step "4/4 sgc evaluate: the expert and the shipped models (a clone, one learned from scratch)"
+"$work/venv/bin/sgc" evaluate --env SGCPoint-v0 --policy expert,shipped:SGCPoint-v0,shipped:ppo_schedule_SGCPoint-v0 \
     --episodes 2 --no-plots --out evaluate
 test -s evaluate/scorecard.md && test -s train/final_model.zip
 step "wheel check passed"
