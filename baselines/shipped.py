@@ -31,22 +31,22 @@ def hyperparams_file(algo: str) -> Traversable:
     return _data("hyperparams") / f"{algo}.yml"
 
 
-def shipped_models() -> dict[str, str]:
-    """Env id -> file path of each packaged model (``checkpoints/ppo_dagger_<id>.zip``)."""
-    prefix, suffix = "ppo_dagger_", ".zip"
-    return {
-        item.name[len(prefix) : -len(suffix)]: str(item)
-        for item in sorted(_data("checkpoints").iterdir(), key=lambda t: t.name)
-        if item.name.startswith(prefix) and item.name.endswith(suffix)
-    }
-
-
 def shipped_files() -> dict[str, str]:
     """File stem -> file path of every packaged model."""
     return {
         item.name[: -len(".zip")]: str(item)
         for item in sorted(_data("checkpoints").iterdir(), key=lambda t: t.name)
         if item.name.endswith(".zip")
+    }
+
+
+def shipped_models() -> dict[str, str]:
+    """Env id -> file path of each id's BC+DAgger model (``checkpoints/ppo_dagger_<id>.zip``)."""
+    prefix = "ppo_dagger_"
+    return {
+        stem[len(prefix) :]: path
+        for stem, path in shipped_files().items()
+        if stem.startswith(prefix)
     }
 
 

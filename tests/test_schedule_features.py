@@ -19,6 +19,7 @@ import sgc_env  # noqa: E402, F401
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
 from baselines.agents.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
 from baselines.agents.train import TrainConfig, train  # noqa: E402
+from sgc_env.envs.rewards import TRACK_COST_CAP, schedule_cost, tracks_of  # noqa: E402
 
 BENCHMARK_HP = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams"
 
@@ -50,19 +51,25 @@ def test_features_are_the_on_schedule_error_and_its_rate() -> None:
     assert extractor.features_dim == 2 * TRACK_FEATURES + 1
     obs, _ = env.reset(seed=3)
     rng = np.random.default_rng(0)
-    done, after_last = False, 0
+    done, after_last, against_reward = False, 0, 0
     while not done:  # a noisy hover-and-follow, so both branches (in a course, after it) occur
         feats = _features(extractor, obs)
         error, rate = _by_hand(env, obs)
         np.testing.assert_allclose(feats[0:3] * 0.05, error, atol=1e-5)
         np.testing.assert_allclose(feats[3:6] * 0.5, rate, atol=1e-5)
+        (track, floor), = tracks_of(env.unwrapped.task)  # the reward's own schedule
+        cost = schedule_cost(track, floor)
+        if cost < TRACK_COST_CAP:
+            scale = max(float(np.linalg.norm(track[2][:3])), floor)
+            assert np.linalg.norm(feats[0:3] * 0.05) == pytest.approx(cost * scale, abs=1e-5)
+            against_reward += 1
         assert np.all(feats[TRACK_FEATURES : 2 * TRACK_FEATURES - 2] == 0)  # no orientation track
         assert feats[-1] == pytest.approx(0.0981)
         after_last += int(feats[TRACK_FEATURES - 3] < 0)  # time left < 0: after the last goal
         action = -0.05 * feats[0:3] - 0.1 * feats[3:6] + [0, 0, feats[-1]] + rng.normal(0, 0.05, 3)
         obs, _, terminated, truncated, _ = env.step(action.astype(np.float32))
         done = terminated or truncated
-    assert not terminated and after_last > 5
+    assert not terminated and after_last > 5 and against_reward > 100
     env.close()
 
 

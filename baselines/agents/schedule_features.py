@@ -76,13 +76,8 @@ class ScheduleFeatures(BaseFeaturesExtractor):
         fields = ("deviation", "rate", "time_left", "course_start", "course_duration",
                   "next_start", "next_duration", "end_velocity", "flags")  # fmt: skip
         for track, deviation, rate in _TRACKS:
-            names = {
-                "deviation": deviation, "rate": rate, "time_left": f"{track}_time_left",
-                "course_start": f"{track}_course_start",
-                "course_duration": f"{track}_course_duration",
-                "next_start": f"{track}_next_start", "next_duration": f"{track}_next_duration",
-                "end_velocity": f"{track}_end_velocity", "flags": f"{track}_flags",
-            }  # fmt: skip
+            names = {key: f"{track}_{key}" for key in fields}
+            names.update(deviation=deviation, rate=rate)
             for key in fields:
                 rows = [_index(layout, b, names[key]) for b in range(n_bodies)]
                 self.register_buffer(f"{track}_{key}", th.tensor(rows, dtype=th.long))
@@ -93,8 +88,9 @@ class ScheduleFeatures(BaseFeaturesExtractor):
             return obs[:, getattr(self, f"{track}_{key}")]  # (batch, bodies, size)
 
         deviation, rate, flags = get("deviation"), get("rate"), get("flags")
-        time_left, duration = get("time_left"), get("course_duration").clamp(min=1e-6)
-        in_course = (time_left >= 0) & (get("course_duration") > 0)
+        time_left, raw_duration = get("time_left"), get("course_duration")
+        duration = raw_duration.clamp(min=1e-6)
+        in_course = (time_left >= 0) & (raw_duration > 0)
         start, end_velocity = get("course_start"), get("end_velocity")
         schedule = th.where(in_course, start * time_left / duration, -end_velocity * time_left)
         schedule_rate = th.where(in_course, -start / duration, end_velocity)
