@@ -1,7 +1,7 @@
 """What the plan check of ``resolve_scenario`` would add to a random-scenario reset.
 
 For each preset it draws scenarios (the reference: what a reset does today), then runs the
-analytic-plan feasibility check (``sgc_env.feasibility.body_demands``) on the same draws and on
+analytic-plan feasibility check (``sgc_env.scenario.demand.body_demands``) on the same draws and on
 the built-in scenes, and prints milliseconds per call and the ratio to the draw (the check is
 skipped on random resets because of this ratio; their analytic bound is tested instead). Last,
 the three-rod demo's force estimate next to the force the expert applies.
@@ -16,9 +16,9 @@ import time
 
 import numpy as np
 
-from sgc_env.feasibility import body_demands
-from sgc_env.random_scenarios import PRESETS, random_scenario
 from sgc_env.scenario import builtin_scenarios, load_scenario
+from sgc_env.scenario.demand import body_demands
+from sgc_env.scenes import PRESETS, random_scenario
 
 
 def main() -> None:

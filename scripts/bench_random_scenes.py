@@ -1,7 +1,7 @@
 """Reset cost of the random paper scenes against their fixed ids, measured in the same run.
 
 For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
-the unwrapped env, the ratio random / fixed, how many feasibility checks (``planner_demand``
+the unwrapped env, the ratio random / fixed, how many feasibility checks (``demand_bounds``
 calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
 one check, and for scale the stepping time of a full-length episode of the random id (mean
 step time under seeded random actions times the episode's steps).
@@ -18,8 +18,7 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
-from sgc_env import random_scenarios
-from sgc_env.random_scenarios import random_scenario
+from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
          ("SGCThreeRods-v0", "SGCThreeRodsRandom-v0", "three_rods"))  # fmt: skip
@@ -57,7 +56,7 @@ def _episode_ms(env_id: str, steps: int) -> float:
 def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     """Checks per kept scene, and the mean ms of one check."""
     calls, seconds = [0], [0.0]
-    check = random_scenarios.planner_demand
+    check = intercept.demand_bounds
 
     def counted(scenario, *args, **kwargs):
         calls[0] += 1
@@ -66,13 +65,13 @@ def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
         seconds[0] += time.perf_counter() - start
         return out
 
-    random_scenarios.planner_demand = counted
+    intercept.demand_bounds = three_rods_random.demand_bounds = counted
     try:
         rng = np.random.default_rng(0)
         for _ in range(scenes):
             random_scenario(rng, family)
     finally:
-        random_scenarios.planner_demand = check
+        intercept.demand_bounds = three_rods_random.demand_bounds = check
     return calls[0] / scenes, seconds[0] / calls[0] * 1e3
 
 

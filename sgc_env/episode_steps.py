@@ -13,21 +13,15 @@ outermost registered wrapper) turns that into a ``ValueError`` at reset.
 from __future__ import annotations
 
 import math
-from importlib import resources
 from typing import Any
 
 import gymnasium as gym
-import yaml
 
-from sgc_env.random_intercept import RandomInterceptConfig
-from sgc_env.random_scenarios import _ACCEL_FACTOR, PRESETS, RandomScenarioConfig, SceneFamily
-from sgc_env.random_three_rods import RandomThreeRodsConfig
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
-from sgc_env.three_rods import EMBED_DURATION, ROD_SPECS
+from sgc_env.scenario.load import builtin_data
+from sgc_env.scenes import SceneFamily, family
 
 __all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
-
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 def scenario_steps(scenario: Scenario) -> int:
@@ -45,32 +39,7 @@ def scenario_steps(scenario: Scenario) -> int:
 
 def random_steps_bound(config: SceneFamily | str) -> int:
     """Most steps an episode of a random-scenario preset or family can last (every draw)."""
-    cfg = PRESETS[config] if isinstance(config, str) else config
-    f = cfg.control_frequency
-    if isinstance(cfg, RandomInterceptConfig):  # the meeting is the last goal
-        return math.ceil(cfg.meeting_time[1] * f) + math.ceil(cfg.margin * f - 1e-9)
-    if isinstance(cfg, RandomThreeRodsConfig):
-        # each rod's last goal: its embed, EMBED_DURATION after a hit time drawn within
-        # hit_time_change of the paper's; the margin is the builder's (as in three_rods.yaml)
-        last = max(spec.hit_time for spec in ROD_SPECS) + cfg.hit_time_change + EMBED_DURATION
-        margin = _builtin("three_rods").margin
-        return math.ceil(last * f) + 1 + math.ceil(margin * f - 1e-9)
-    return _courses_bound(cfg)
-
-
-def _courses_bound(cfg: RandomScenarioConfig) -> int:
-    """Mirrors :func:`~sgc_env.random_scenarios.random_scenario`: a course of length ``L`` is
-    flown at no less than ``min(speed_low, cap)``, where ``cap`` (the speed the force budget
-    allows after a course flown at ``v_prev``) grows with ``L`` slower than ``L`` and falls
-    with ``v_prev``; so ``L / speed`` is largest for the longest course after the fastest one.
-    """
-    f = cfg.control_frequency
-    accel_budget = 0.9 * (cfg.force_limit / cfg.mass - 9.81)
-    length, v_prev = cfg.spacing[1], cfg.speed[1]
-    cap = 0.5 * (-v_prev + math.sqrt(v_prev**2 + 4 * accel_budget * length / _ACCEL_FACTOR))
-    slowest = min(cfg.speed[0], cap)
-    course = max(6, math.ceil(length / slowest * f + 1e-6))
-    return cfg.n_goals[1] * course + math.ceil(cfg.margin * f - 1e-9)
+    return family(config).max_steps()
 
 
 def registered_steps(kwargs: dict[str, Any]) -> int:
@@ -82,8 +51,7 @@ def registered_steps(kwargs: dict[str, Any]) -> int:
 
 def _builtin(name: str) -> Scenario:
     """A built-in scenario as written (validated, not resolved: cheap enough for import)."""
-    text = (resources.files("sgc_env") / "scenarios" / f"{name}.yaml").read_text()
-    return scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name)
+    return scenario_from_dict(builtin_data(name), name=name)
 
 
 class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):

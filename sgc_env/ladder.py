@@ -15,7 +15,7 @@ from typing import Any, cast
 
 import gymnasium as gym
 
-from sgc_env.random_scenarios import PRESETS
+from sgc_env.scenes import PRESETS
 
 __all__ = ["LADDER", "Rung", "goal_counts", "markdown", "short_markdown"]
 

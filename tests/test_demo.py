@@ -15,8 +15,9 @@ from baselines.cli.demo_camera import DEMO_SHOTS, camera_at
 from baselines.cli.main import main
 from baselines.evaluation import run_episode
 from baselines.expert import SGCExpert
-from sgc_env import three_rods
 from sgc_env.paper.frames import normalized_frame
+from sgc_env.scenario.load import builtin_path
+from sgc_env.scenes import three_rods
 from sgc_env.simulator import pybullet
 
 MIN_SPEED_FRACTION = 0.1
@@ -61,7 +62,7 @@ def _assert_same_tree(shipped, built, path: str = "") -> None:
 
 
 def test_shipped_yaml_is_what_the_builder_makes():
-    shipped = yaml.safe_load(three_rods.YAML_PATH.read_text())
+    shipped = yaml.safe_load(builtin_path("three_rods").read_text())
     _assert_same_tree(shipped, yaml.safe_load(yaml.safe_dump(three_rods.build_three_rods())))
     assert [len(b["goals"]) for b in shipped["bodies"]] == [25, 16, 17]
     somersaults = [g for b in shipped["bodies"] for g in b["goals"] if "relative_rotation" in g]

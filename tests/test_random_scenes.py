@@ -12,11 +12,11 @@ import pytest
 
 import sgc_env
 from baselines.expert import SGCExpert
-from sgc_env import random_intercept, random_three_rods
 from sgc_env.envs import SGCEnv
-from sgc_env.random_intercept import RandomInterceptConfig
-from sgc_env.random_scenarios import planner_demand, random_scenario
-from sgc_env.random_three_rods import RandomThreeRodsConfig
+from sgc_env.scenario.demand import demand_bounds
+from sgc_env.scenes import RandomInterceptConfig, RandomThreeRodsConfig, random_scenario
+from sgc_env.scenes import intercept as random_intercept
+from sgc_env.scenes import three_rods_random as random_three_rods
 
 EXACT = 1e-9
 DEMAND_SHARE = 0.8  # what both families allow the plan's bounds to use of each limit
@@ -60,7 +60,7 @@ def _check_expert(env_id: str, seeds, *, against_plan: bool = False) -> float:
         assert max(errors) <= EXACT, (env_id, seed, max(errors))
         assert peaks[:, 0].max() < 1.0, (env_id, seed, "saturated")
         if against_plan:  # the margin the draws keep covers the expert's per-tick wrench
-            bounds = np.array(planner_demand(scenario))
+            bounds = np.array(demand_bounds(scenario))
             assert np.all(peaks[:, 1:] <= bounds / DEMAND_SHARE), (env_id, seed, peaks, bounds)
         worst = max(worst, float(peaks[:, 0].max()))
     env.close()
@@ -140,7 +140,7 @@ def test_draws_keep_the_planned_demand_inside_the_limits():
         for _ in range(count):
             scenario = random_scenario(rng, family)
             for body, (force, torque) in zip(
-                scenario.bodies, planner_demand(scenario), strict=True
+                scenario.bodies, demand_bounds(scenario), strict=True
             ):
                 assert force <= DEMAND_SHARE * body.force_limit
                 assert torque <= DEMAND_SHARE * body.torque_limit

@@ -15,7 +15,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 import sgc_env
 from baselines import SGCExpert
 from sgc_env.episode_steps import random_steps_bound, scenario_steps
-from sgc_env.random_scenarios import PRESETS, random_scenario
+from sgc_env.scenes import PRESETS, random_scenario
 
 
 @pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 import yaml
 
-from sgc_env.random_scenarios import RandomScenarioConfig, random_scenario
 from sgc_env.scenario import (
     Body,
     Goal,
@@ -23,6 +22,7 @@ from sgc_env.scenario import (
     resolve_scenario,
     scenario_from_dict,
 )
+from sgc_env.scenes import RandomScenarioConfig, random_scenario
 
 BASE = {
     "name": "t",
@@ -212,13 +212,13 @@ def test_unknown_builtin_lists_choices():
 @pytest.mark.parametrize("preset", ["point", "rod"])
 def test_random_limits_cover_the_analytic_plan(preset):
     pytest.importorskip("sgc_env.paper.plan")
-    from sgc_env.random_scenarios import planner_demand
+    from sgc_env.scenario.demand import demand_bounds
 
     rng = np.random.default_rng(123)
     for _ in range(12):
         s = random_scenario(rng, preset)
         body = s.bodies[0]
-        ((force, torque),) = planner_demand(s, samples=100)
+        ((force, torque),) = demand_bounds(s, samples=100)
         assert force < body.force_limit
         if body.has_orientation_track:
             assert torque < body.torque_limit

@@ -88,7 +88,7 @@ class DemoScene:
     """The visual-only dressing: bullseye, thick rod shells, carried balls."""
 
     def __init__(self, sim: Simulator, scenario: Any) -> None:
-        from sgc_env import three_rods
+        from sgc_env.scenes import three_rods
 
         self.sim = sim
         client = sim.client

@@ -94,7 +94,7 @@ goal orientation, in [0, pi], at that tick; None for a missing part).
 ## Arguments
 
 ``scenario`` (Scenario, built-in name or YAML path) or ``random_scenario`` (a preset name of
-``sgc_env.random_scenarios.PRESETS`` or a config of a scene family, redrawn from ``np_random``
+``sgc_env.scenes.PRESETS`` or a config of a scene family, redrawn from ``np_random``
 on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
 (240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
@@ -120,10 +120,10 @@ import numpy as np
 from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.paper.quaternion import rotate, rotate_back
-from sgc_env.random_scenarios import PRESETS, SceneFamily
-from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
+from sgc_env.scenes import PRESETS, SceneFamily
+from sgc_env.scenes import random_scenario as draw_random_scenario
 from sgc_env.simulator import Drive, Simulator
 
 from .props import PropPaths

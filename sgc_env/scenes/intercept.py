@@ -6,18 +6,21 @@ nail (timed by routing) and must meet a kinematic target (the "fish", a piecewis
 path) at a drawn meeting time. Body, prop and limits are those of ``intercept.yaml``, so the
 observation and action spaces are those of ``SGCIntercept-v0`` for every draw.
 
-Feasibility: a draw is kept only if the analytic plan (``planner_demand``, evaluated per
+Feasibility: a draw is kept only if the analytic plan (``demand_bounds``, evaluated per
 course: a few milliseconds) needs at most ``demand_share`` of the force limit; otherwise the
 whole scene is redrawn. Tests run the expert inside PyBullet on the draws.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from sgc_env.scenario import Body, Goal, Prop, Scenario, resolve_scenario
+from sgc_env.scenario.demand import demand_bounds
+from sgc_env.scenario.model import grid_time
 
 __all__ = ["RandomInterceptConfig", "random_intercept"]
 
@@ -77,6 +80,11 @@ class RandomInterceptConfig:
         """The bird's goals: the drawn intermediate nail and the meeting."""
         return ((2, 2),)
 
+    def max_steps(self) -> int:
+        """The meeting is the last goal: the latest meeting time plus the margin."""
+        f = self.control_frequency
+        return math.ceil(self.meeting_time[1] * f) + math.ceil(self.margin * f - 1e-9)
+
 
 def _direction(rng: np.random.Generator) -> np.ndarray:
     v = rng.normal(size=3)
@@ -87,14 +95,12 @@ def random_intercept(
     rng: np.random.Generator, config: RandomInterceptConfig | None = None
 ) -> Scenario:
     """Draw one resolved, feasible interception from ``rng`` (redraws infeasible scenes)."""
-    from sgc_env.random_scenarios import planner_demand  # it draws through this module
-
     cfg = config or RandomInterceptConfig()
     for _ in range(MAX_DRAWS):
         scenario = _draw(rng, cfg)
         if scenario is None:
             continue
-        ((force, _),) = planner_demand(scenario, samples=64)
+        ((force, _),) = demand_bounds(scenario, samples=64)
         if force <= cfg.demand_share * cfg.force_limit:
             return scenario
     raise RuntimeError(
@@ -107,7 +113,7 @@ def _draw(rng: np.random.Generator, cfg: RandomInterceptConfig) -> Scenario | No
     f = cfg.control_frequency
     start = np.asarray(cfg.start) + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)
     velocity = _direction(rng) * rng.uniform(*cfg.start_speed)
-    meet = round(rng.uniform(*cfg.meeting_time) * f) / f
+    meet = grid_time(rng.uniform(*cfg.meeting_time), f)
     # The fish swims in straight legs; its path outlasts the meeting time by the margin.
     leg_end = np.linspace(0.0, meet + cfg.margin + 0.5, cfg.fish_legs + 1)
     fish = [np.asarray(cfg.fish_start) + rng.uniform(-cfg.fish_spread, cfg.fish_spread, 3)]
@@ -147,7 +153,7 @@ def _draw(rng: np.random.Generator, cfg: RandomInterceptConfig) -> Scenario | No
         margin=cfg.margin,
         control_frequency=f,
     )
-    # random_intercept keeps a draw only under its own demand share (planner_demand), so the
+    # random_intercept keeps a draw only under its own demand share (demand_bounds), so the
     # plan check of resolve_scenario would run the planner twice and raise instead of redraw.
     return resolve_scenario(scenario, check_plan=False)
 

@@ -1,4 +1,4 @@
-"""Random three-rod scenes: the paper's demo (``sgc_env.three_rods``) with its paths, red
+"""Random three-rod scenes: the paper's demo (``sgc_env.scenes.three_rods``) with its paths, red
 balls and target times drawn from the env's ``np_random`` on every reset.
 
 Each rod's path is the cubic spline through the paper's waypoints moved by drawn offsets
@@ -9,7 +9,7 @@ spaces are those of ``SGCThreeRods-v0`` for every draw; the limits are constants
 (twice the paper scene's).
 
 Feasibility: a rod is kept only if bounds of the force and torque along its analytic plan
-(``planner_demand``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
+(``demand_bounds``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
 Planning the rods costs far more than a reset of a fixed scene (``docs/environments.md`` has
 the figures).
 ``tests/test_random_scenes.py`` runs the expert inside PyBullet on the draws.
@@ -17,13 +17,18 @@ the figures).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
-from sgc_env.three_rods import (
+from sgc_env.scenario.demand import demand_bounds
+from sgc_env.scenario.model import grid_time
+from sgc_env.scenes.three_rods import (
+    EMBED_DURATION,
     FORCE_LIMIT,
+    MARGIN,
     ROD_MASS,
     ROD_SPECS,
     TARGET_CENTER,
@@ -96,14 +101,17 @@ class RandomThreeRodsConfig:
             for s in ROD_SPECS
         )
 
+    def max_steps(self) -> int:
+        """Each rod's last goal is its embed, ``EMBED_DURATION`` after a hit time drawn within
+        ``hit_time_change`` of the paper's; the margin is the builder's."""
+        f = self.control_frequency
+        last = max(spec.hit_time for spec in ROD_SPECS) + self.hit_time_change + EMBED_DURATION
+        return math.ceil(last * f) + 1 + math.ceil(MARGIN * f - 1e-9)
+
 
 def _vec3(v: np.ndarray) -> tuple[float, float, float]:
     x, y, z = (float(c) for c in v)
     return x, y, z
-
-
-def _on_grid(t: float, frequency: int) -> float:
-    return round(t * frequency) / frequency
 
 
 def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfig) -> RodSpec:
@@ -128,8 +136,8 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
         waypoints=tuple(_vec3(p) for p in moved),
         samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
         samples_after=after,
-        hit_time=_on_grid(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
-        pierce_time=_on_grid(rng.uniform(*cfg.pierce_time), f),
+        hit_time=grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
+        pierce_time=grid_time(rng.uniform(*cfg.pierce_time), f),
         ball_velocity=_vec3(direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)),
         somersault_sample=None,
     )
@@ -162,8 +170,6 @@ def random_three_rods(
 
 def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
     """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
-    from sgc_env.random_scenarios import planner_demand  # it draws through this module
-
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
         spec = _rod_spec(rng, ROD_SPECS[k], cfg)
@@ -178,7 +184,7 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
         # The demand share below is the feasibility check (stricter than resolve_scenario's
         # plan check, which would run the planner twice and raise instead of redraw).
         scenario = resolve_scenario(scenario_from_dict(data), check_plan=False)
-        ((force, torque),) = planner_demand(scenario)
+        ((force, torque),) = demand_bounds(scenario)
         if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
             return scenario
     raise RuntimeError(

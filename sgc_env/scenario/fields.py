@@ -1,0 +1,165 @@
+"""The scenario's fields: shapes, the LIMITS table and the checks that turn raw values into typed
+ones with a ScenarioError naming the field path.
+
+Numbers are checked against ``LIMITS`` (name -> low, high, unit, where the bound comes from),
+so that nothing that loads can overflow the float32 observation (bounds +-1e5), leave what
+PyBullet simulates faithfully, or make the work of loading and running unbounded.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from sgc_env.scenario.model import Quat, ScenarioError
+
+__all__ = [
+    "LIMITS", "MAX_EPISODE_STEPS", "MAX_GOALS", "MAX_HELIX_TURNS", "MAX_PATH_SAMPLES",
+    "MAX_WAYPOINTS", "SHAPES", "TIME_GRID_MODES", "WORKSPACE_LIMIT", "check_keys",
+    "coords_in_range", "fail", "in_range", "limit_text", "mapping", "norm_in_range", "number",
+    "quaternion", "require", "vector",
+]  # fmt: skip
+
+SHAPES: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius",),
+    "rod": ("length", "radius"),
+    "box": ("half_x", "half_y", "half_z"),
+}
+TIME_GRID_MODES = ("reject", "snap")
+WORKSPACE_LIMIT = 1e4  # keeps every observation entry inside the env's +-1e5 bounds
+MAX_EPISODE_STEPS = 100_000  # control ticks; the harness's default episode cap
+MAX_PATH_SAMPLES = 1_000
+MAX_GOALS = 10_000  # per body
+MAX_WAYPOINTS = 10_000  # per prop
+MAX_HELIX_TURNS = 1_000
+
+LIMITS: dict[str, tuple[float, float, str, str]] = {
+    "mass": (1e-6, 1e6, "kg",
+             "PyBullet makes a body of mass <= ~1e-16 static; 1e-6 keeps ten orders of margin"),
+    "size": (1e-3, 1e3, "m",
+             "inertia ~ m size^2 must stay far from underflow; a body fits the workspace"),
+    "force_limit": (1e-9, 1e7, "N", "forces are reported in float32 (7 significant digits)"),
+    "torque_limit": (1e-9, 1e7, "N m", "torques are reported in float32 (7 significant digits)"),
+    "speed": (0.0, 90.0, "m/s", "PyBullet clamps linear speed at 100 m/s; the env ends at 90"),
+    "spin": (0.0, 99.0, "rad/s", "PyBullet clamps angular speed at 100 rad/s"),
+    "coordinate": (-WORKSPACE_LIMIT, WORKSPACE_LIMIT, "m",
+                   "positions and deviations stay inside the observation bounds +-1e5"),
+    "point": (0.0, WORKSPACE_LIMIT, "m",
+              "the tracked point's offset is observed (bounds +-1e5)"),
+    "time": (0.0, 1e4, "s",
+             "float32 time in the observation still resolves 1 ms; the episode cap is "
+             f"{MAX_EPISODE_STEPS} ticks"),
+    "margin": (0.0, 1e3, "s", "the episode runs this long after the last goal"),
+    "relative_rotation": (0.0, 64 * math.pi, "rad",  # = paper.orientation.MAX_RELATIVE_ROTATION
+                          "32 turns (96 planner courses of 2 pi / 3) per goal"),
+    "gravity": (0.0, 1e3, "m/s^2", "about 100 g; forces to hold a body must stay reportable"),
+    "weight": (1e-9, 1e9, "", "routing divides by weights; their ratios set goal times"),
+    "control_frequency": (1, 1000, "Hz", "the simulation runs an integer multiple of it"),
+    "color": (0.0, 1.0, "", "RGBA components"),
+    "prop_velocity": (0.0, 1e3, "m/s", "a prop must stay near the workspace for its episode"),
+}  # fmt: skip
+
+
+# ---------------------------------------------------------------- parsing helpers
+
+
+def fail(path: str, msg: str) -> ScenarioError:
+    return ScenarioError(f"{path}: {msg}")
+
+
+def number(value: Any, path: str, *, positive: bool = False, nonneg: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        kind = "a positive number" if positive else "a number"
+        raise fail(path, f"expected {kind}, got {value!r}{quoted_hint(value)}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise fail(path, f"expected a finite number, got {value!r}")
+    if positive and v <= 0:
+        raise fail(path, f"expected a positive number, got {v!r}")
+    if nonneg and v < 0:
+        raise fail(path, f"expected a number >= 0, got {v!r}")
+    return v
+
+
+def quoted_hint(value: Any) -> str:
+    """Why a number arrived as a string: it was quoted in the YAML file."""
+    if isinstance(value, str):
+        try:
+            float(value)
+        except ValueError:
+            return ""
+        return " (a string: YAML reads a quoted number as text; remove the quotes)"
+    return ""
+
+
+def vector(value: Any, n: int, path: str) -> tuple[float, ...]:
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise fail(path, f"expected a list of {n} numbers, got {value!r}")
+    if len(value) != n:
+        raise fail(path, f"expected {n} numbers, got {len(value)}")
+    out = []
+    for x in value:
+        if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
+            raise fail(path, f"expected {n} numbers, got {list(value)!r}{quoted_hint(x)}")
+        out.append(float(x))
+    if any(math.isnan(x) for x in out):
+        raise fail(path, "contains NaN")
+    if any(math.isinf(x) for x in out):
+        raise fail(path, "contains an infinite value")
+    return tuple(out)
+
+
+def quaternion(value: Any, path: str) -> Quat:
+    q = vector(value, 4, path)
+    norm = math.sqrt(sum(x * x for x in q))
+    if abs(norm - 1.0) > 1e-3:
+        raise fail(
+            path, f"bad quaternion: norm {norm:.6g}, expected a unit quaternion (x, y, z, w)"
+        )
+    return tuple(x / norm for x in q)  # type: ignore[return-value]
+
+
+def mapping(value: Any, path: str) -> Mapping[str, Any]:
+    if not isinstance(value, Mapping):
+        raise fail(path, f"expected a mapping, got {type(value).__name__}")
+    return value
+
+
+def check_keys(d: Mapping[str, Any], allowed: set[str], path: str) -> None:
+    unknown = sorted(set(d) - allowed)
+    if unknown:
+        raise fail(path, f"unknown field(s) {unknown}; expected some of {sorted(allowed)}")
+
+
+def require(d: Mapping[str, Any], key: str, path: str) -> Any:
+    if key not in d:
+        raise fail(f"{path}.{key}" if path else key, "missing required field")
+    return d[key]
+
+
+def limit_text(key: str) -> str:
+    lo, hi, unit, why = LIMITS[key]
+    unit = f" {unit}" if unit else ""
+    return f"[{lo:g}, {hi:g}]{unit} ({why})"
+
+
+def in_range(value: float, key: str, path: str) -> float:
+    """``value`` inside ``LIMITS[key]``, else a message with the bound and its reason."""
+    lo, hi, unit, _ = LIMITS[key]
+    if not lo <= value <= hi:
+        raise fail(path, f"{value!r} is outside {limit_text(key)}")
+    return value
+
+
+def norm_in_range(vec: Sequence[float], key: str, path: str) -> None:
+    norm = math.sqrt(math.fsum(x * x for x in vec))
+    if not math.isfinite(norm) or norm > LIMITS[key][1]:
+        raise fail(path, f"magnitude {norm:.6g} of {tuple(vec)} is outside {limit_text(key)}")
+
+
+def coords_in_range(vec: Sequence[float], path: str) -> None:
+    for x in vec:
+        in_range(x, "coordinate", path)

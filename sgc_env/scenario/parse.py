@@ -1,0 +1,264 @@
+"""Plain data (as loaded from YAML) -> an unresolved :class:`Scenario`, checking every type.
+
+Each value is checked where it enters, and every error names its field path
+(``bodies[0].goals[1].time``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from sgc_env.scenario.curves import parametric_curve, path_goals
+from sgc_env.scenario.fields import (
+    MAX_GOALS,
+    MAX_HELIX_TURNS,
+    MAX_PATH_SAMPLES,
+    MAX_WAYPOINTS,
+    check_keys,
+    fail,
+    mapping,
+    number,
+    quaternion,
+    require,
+    vector,
+)
+from sgc_env.scenario.model import Body, Goal, Prop, Scenario, ScenarioError
+
+__all__ = ["scenario_from_dict"]
+
+_GOAL_KEYS = {"nail", "point", "orientation", "relative_rotation", "time", "critical", "weight"}
+_PATH_KEYS = {"path", "samples", "point", "time", "weight"}
+
+
+def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
+    if not isinstance(raw, list):
+        raise fail(path, f"expected a list of goals, got {type(raw).__name__}")
+    if len(raw) > MAX_GOALS:
+        raise fail(path, f"{len(raw)} goals; at most {MAX_GOALS} per body")
+    goals: list[Goal] = []
+    for j, g in enumerate(raw):
+        p = f"{path}[{j}]"
+        g = mapping(g, p)
+        if "path" in g:
+            check_keys(g, _PATH_KEYS, p)
+            goals.extend(_parse_path_goal(g, p))
+            continue
+        check_keys(g, _GOAL_KEYS, p)
+        nail, nail_prop = None, None
+        if "nail" in g:
+            if isinstance(g["nail"], Mapping):
+                spec = g["nail"]
+                check_keys(spec, {"prop"}, f"{p}.nail")
+                nail_prop = str(require(spec, "prop", f"{p}.nail"))
+            else:
+                nail = vector(g["nail"], 3, f"{p}.nail")
+        time = None if g.get("time") is None else number(g["time"], f"{p}.time")
+        critical = g.get("critical")
+        if critical is not None and not isinstance(critical, bool):
+            raise fail(f"{p}.critical", f"expected true or false, got {critical!r}")
+        goals.append(
+            Goal(
+                nail=nail,  # type: ignore[arg-type]
+                nail_prop=nail_prop,
+                point=vector(g.get("point", (0, 0, 0)), 3, f"{p}.point"),  # type: ignore[arg-type]
+                orientation=None
+                if g.get("orientation") is None
+                else quaternion(g["orientation"], f"{p}.orientation"),
+                relative_rotation=None
+                if g.get("relative_rotation") is None
+                else vector(g["relative_rotation"], 3, f"{p}.relative_rotation"),  # type: ignore[arg-type]
+                time=time,
+                critical=critical,
+                weight=number(g.get("weight", 1.0), f"{p}.weight"),
+            )
+        )
+    return tuple(goals)
+
+
+def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
+    spec = dict(mapping(g["path"], f"{p}.path"))
+    kind = require(spec, "curve", f"{p}.path")
+    samples = require(g, "samples", p)
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise fail(f"{p}.samples", f"expected an integer >= 1, got {samples!r}")
+    if samples > MAX_PATH_SAMPLES:
+        raise fail(
+            f"{p}.samples",
+            f"{samples} samples; at most {MAX_PATH_SAMPLES} (each sample is a goal of its own, "
+            "and needs at least one control tick)",
+        )
+    spec.pop("curve")
+    turns = spec.get("turns")
+    if isinstance(turns, int | float) and not isinstance(turns, bool):
+        if not abs(turns) <= MAX_HELIX_TURNS:
+            raise fail(f"{p}.path.turns", f"{turns!r}: at most {MAX_HELIX_TURNS} turns")
+    try:
+        curve = parametric_curve(str(kind), **spec)
+        pts = np.asarray([curve(s) for s in (0.0, 0.5, 1.0)], float)
+    except ScenarioError as exc:
+        raise fail(f"{p}.path.curve", str(exc)) from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise fail(f"{p}.path", f"bad parameters for curve {kind!r}: {exc}") from None
+    if not np.all(np.isfinite(pts)):
+        raise fail(f"{p}.path", "curve gives non-finite points")
+    time = None if g.get("time") is None else number(g["time"], f"{p}.time")
+    return path_goals(
+        curve,
+        samples,
+        time=time,
+        point=vector(g.get("point", (0, 0, 0)), 3, f"{p}.point"),  # type: ignore[arg-type]
+        weight=number(g.get("weight", 1.0), f"{p}.weight"),
+    )
+
+
+_BODY_KEYS = {
+    "name", "shape", "size", "mass", "position", "orientation", "linear_velocity",
+    "angular_velocity", "color", "force_limit", "torque_limit", "goals", "end_velocity",
+    "end_angular_velocity", "collisions",
+}  # fmt: skip
+_PROP_KEYS = {"name", "shape", "size", "color", "position", "velocity", "waypoints", "collisions"}
+_SCENARIO_KEYS = {
+    "name", "bodies", "props", "goals", "gravity", "workspace", "margin", "control_frequency",
+    "time_grid", "allow_saturation", "end_velocity_rule",
+}  # fmt: skip
+
+
+def _size(value: Any, path: str) -> tuple[float, ...]:
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        value = [value]
+    if not isinstance(value, list | tuple):
+        raise fail(path, f"expected a list of numbers, got {value!r}")
+    return tuple(number(v, f"{path}[{i}]") for i, v in enumerate(value))
+
+
+def _bool(value: Any, path: str) -> bool:
+    if not isinstance(value, bool):
+        raise fail(path, f"expected true or false, got {value!r}")
+    return value
+
+
+def _parse_body(d: Any, path: str) -> Body:
+    d = mapping(d, path)
+    check_keys(d, _BODY_KEYS, path)
+    name = require(d, "name", path)
+    if not isinstance(name, str) or not name:
+        raise fail(f"{path}.name", f"expected a non-empty string, got {name!r}")
+    kw: dict[str, Any] = {"name": name}
+    if "shape" in d:
+        kw["shape"] = d["shape"]
+    if "size" in d:
+        kw["size"] = _size(d["size"], f"{path}.size")
+    for key in ("mass", "force_limit", "torque_limit"):
+        if key in d:
+            kw[key] = number(d[key], f"{path}.{key}")
+    for key in ("position", "linear_velocity", "angular_velocity"):
+        if key in d:
+            kw[key] = vector(d[key], 3, f"{path}.{key}")
+    for key in ("end_velocity", "end_angular_velocity"):
+        if d.get(key) is not None:
+            kw[key] = vector(d[key], 3, f"{path}.{key}")
+    if "orientation" in d:
+        kw["orientation"] = quaternion(d["orientation"], f"{path}.orientation")
+    if "color" in d:
+        kw["color"] = _color(d["color"], f"{path}.color")
+    if "collisions" in d:
+        kw["collisions"] = _bool(d["collisions"], f"{path}.collisions")
+    if "goals" in d:
+        kw["goals"] = _parse_goals(d["goals"], f"{path}.goals")
+    return Body(**kw)
+
+
+def _color(value: Any, path: str) -> tuple[float, float, float, float]:
+    if isinstance(value, list | tuple) and len(value) == 3:
+        value = [*value, 1.0]
+    return vector(value, 4, path)  # type: ignore[return-value]
+
+
+def _parse_prop(d: Any, path: str) -> Prop:
+    d = mapping(d, path)
+    check_keys(d, _PROP_KEYS, path)
+    kw: dict[str, Any] = {"name": require(d, "name", path)}
+    if "shape" in d:
+        kw["shape"] = d["shape"]
+    if "size" in d:
+        kw["size"] = _size(d["size"], f"{path}.size")
+    if "color" in d:
+        kw["color"] = _color(d["color"], f"{path}.color")
+    for key in ("position", "velocity"):
+        if key in d:
+            kw[key] = vector(d[key], 3, f"{path}.{key}")
+    if "collisions" in d:
+        kw["collisions"] = _bool(d["collisions"], f"{path}.collisions")
+    if "waypoints" in d:
+        wps = d["waypoints"]
+        if not isinstance(wps, list) or not wps:
+            raise fail(f"{path}.waypoints", "expected a non-empty list of {time, position}")
+        if len(wps) > MAX_WAYPOINTS:
+            raise fail(f"{path}.waypoints", f"{len(wps)} waypoints; at most {MAX_WAYPOINTS}")
+        out = []
+        for i, w in enumerate(wps):
+            wp = f"{path}.waypoints[{i}]"
+            w = mapping(w, wp)
+            check_keys(w, {"time", "position"}, wp)
+            out.append(
+                (
+                    number(require(w, "time", wp), f"{wp}.time"),
+                    vector(require(w, "position", wp), 3, f"{wp}.position"),
+                )
+            )
+        kw["waypoints"] = tuple(out)
+    return Prop(**kw)
+
+
+def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
+    """Build an unresolved scenario from plain data (as loaded from YAML), checking types."""
+    d = mapping(data, "scenario")
+    check_keys(d, _SCENARIO_KEYS, "scenario")
+    bodies_raw = require(d, "bodies", "")
+    if not isinstance(bodies_raw, list) or not bodies_raw:
+        raise fail("bodies", "expected a non-empty list of bodies")
+    bodies = [_parse_body(b, f"bodies[{i}]") for i, b in enumerate(bodies_raw)]
+    if d.get("goals") is not None:
+        extra = mapping(d["goals"], "goals")
+        names = [b.name for b in bodies]
+        for body_name, goal_list in extra.items():
+            if body_name not in names:
+                raise fail("goals", f"goals refer to unknown body {body_name!r}; bodies: {names}")
+            i = names.index(body_name)
+            new = _parse_goals(goal_list, f"goals.{body_name}")
+            bodies[i] = replace(bodies[i], goals=bodies[i].goals + new)
+    props_raw = d.get("props") or []
+    if not isinstance(props_raw, list):
+        raise fail("props", f"expected a list of props, got {type(props_raw).__name__}")
+    kw: dict[str, Any] = {
+        "bodies": tuple(bodies),
+        "props": tuple(_parse_prop(p, f"props[{i}]") for i, p in enumerate(props_raw)),
+        "name": str(d.get("name", name or "scenario")),
+    }
+    if "gravity" in d:
+        kw["gravity"] = vector(d["gravity"], 3, "gravity")
+    if "workspace" in d:
+        ws = mapping(d["workspace"], "workspace")
+        check_keys(ws, {"low", "high"}, "workspace")
+        kw["workspace"] = (
+            vector(require(ws, "low", "workspace"), 3, "workspace.low"),
+            vector(require(ws, "high", "workspace"), 3, "workspace.high"),
+        )
+    if "margin" in d:
+        kw["margin"] = number(d["margin"], "margin", nonneg=True)
+    if "control_frequency" in d:
+        cf = d["control_frequency"]
+        if isinstance(cf, bool) or not isinstance(cf, int) or cf <= 0:
+            raise fail("control_frequency", f"expected a positive integer (Hz), got {cf!r}")
+        kw["control_frequency"] = cf
+    if "time_grid" in d:
+        kw["time_grid"] = d["time_grid"]
+    if "allow_saturation" in d:
+        kw["allow_saturation"] = _bool(d["allow_saturation"], "allow_saturation")
+    if "end_velocity_rule" in d:
+        kw["end_velocity_rule"] = d["end_velocity_rule"]
+    return Scenario(**kw)
