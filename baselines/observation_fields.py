@@ -18,7 +18,6 @@ from sgc_env.observation import ObservationLayout
 
 __all__ = ["COURSE_SIZE", "BodyFields", "BodyObservation", "TrackFields", "read_body"]
 
-TRACKS = ("position", "orientation")
 _COURSE_FIELDS = ("course_start", "course_duration", "next_start", "next_duration",
                   "end_velocity", "flags")  # fmt: skip
 _COURSE_LAYOUT = [(0, 3), (3, 4), (4, 7), (7, 8), (8, 11), (11, 13)]

@@ -19,6 +19,7 @@ import gymnasium as gym
 
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
 from sgc_env.scenario.load import builtin_data
+from sgc_env.scenario.model import grid_tick
 from sgc_env.scenes import SceneFamily, family
 
 __all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
@@ -34,7 +35,7 @@ def scenario_steps(scenario: Scenario) -> int:
         scenario = resolve_scenario(scenario)
     f = scenario.control_frequency
     times = [float(g.time) for b in scenario.bodies for g in b.goals if g.time is not None]
-    return max(round(t * f) for t in times) + math.ceil(scenario.margin * f - 1e-9)
+    return max(grid_tick(t, f) for t in times) + math.ceil(scenario.margin * f - 1e-9)
 
 
 def random_steps_bound(config: SceneFamily | str) -> int:

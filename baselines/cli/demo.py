@@ -31,7 +31,6 @@ from sgc_env.simulator import Simulator, pybullet
 __all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
 
 ENV_ID = "SGCThreeRods-v0"
-PLATES = 8
 PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
 """Moments the plates show: launch, piercing, flight, somersault, the hits, all three in."""
 ROD_DRAW_RADIUS = 0.075

@@ -25,6 +25,7 @@ from sgc_env.paper.quaternion import log as rotvec_from_quat
 from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
 from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
+from sgc_env.simulator import BodyState
 
 from .rewards import DistanceReward
 from .tracks import BodyTracks, Track, compile_tracks
@@ -36,10 +37,6 @@ __all__ = [
     "RewardFunction",
     "TaskCounters",
 ]
-
-BodyState = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]
-"""One body as the simulator reads it: position, quaternion xyzw, linear and angular velocity
-(world frame)."""
 
 _ZERO3 = (0.0, 0.0, 0.0)
 _ZERO6 = (0.0,) * 6

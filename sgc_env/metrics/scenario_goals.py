@@ -6,10 +6,10 @@ from collections.abc import Sequence
 from typing import cast
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from sgc_env.metrics.trajectory import GoalSpec
 from sgc_env.scenario import Scenario
+from sgc_env.scenario.model import goal_orientations
 
 
 def goals_from_scenario(scenario: Scenario) -> list[list[GoalSpec]]:
@@ -23,19 +23,11 @@ def goals_from_scenario(scenario: Scenario) -> list[list[GoalSpec]]:
         raise ValueError("scenario must be resolved (see sgc_env.scenario.resolve_scenario)")
     out: list[list[GoalSpec]] = []
     for body in scenario.bodies:
-        previous = Rotation.from_quat(np.asarray(body.orientation, dtype=float))
         specs = []
-        for goal in body.goals:
-            orientation: tuple[float, float, float, float] | None = None
+        for goal, orientation in zip(body.goals, goal_orientations(body), strict=True):
             angle = None
             if goal.relative_rotation is not None:
-                rel = np.asarray(goal.relative_rotation, dtype=float)
-                previous = Rotation.from_rotvec(rel) * previous
-                orientation = _quat(previous.as_quat())
-                angle = float(np.linalg.norm(rel))
-            elif goal.orientation is not None:
-                previous = Rotation.from_quat(np.asarray(goal.orientation, dtype=float))
-                orientation = _quat(goal.orientation)
+                angle = float(np.linalg.norm(np.asarray(goal.relative_rotation, dtype=float)))
             specs.append(
                 GoalSpec(
                     time=float(cast(float, goal.time)),  # resolved: every goal has its time
@@ -53,7 +45,3 @@ def _vec3(v: Sequence[float]) -> tuple[float, float, float]:
     x, y, z = (float(c) for c in v)
     return x, y, z
 
-
-def _quat(q: Sequence[float]) -> tuple[float, float, float, float]:
-    x, y, z, w = (float(c) for c in q)
-    return x, y, z, w

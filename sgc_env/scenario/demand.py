@@ -21,7 +21,7 @@ import numpy as np
 
 from sgc_env.paper import quaternion as quat
 from sgc_env.scenario.fields import LIMITS, fail
-from sgc_env.scenario.model import Body, Scenario
+from sgc_env.scenario.model import Body, Scenario, grid_tick
 
 if TYPE_CHECKING:
     from sgc_env.paper.plan import BodyPlan
@@ -130,7 +130,7 @@ def body_demand(scenario: Scenario, b: Body, periods: int | None = None) -> Body
     # angular acceleration about every axis), so a torque about the axis of least inertia
     # counts max(I) / I times against torque_limit.
     axis_weight = moments.max() / moments
-    goal_ticks = [round(float(gl.time) * freq) for gl in b.goals]  # type: ignore[arg-type]
+    goal_ticks = [grid_tick(float(gl.time), freq) for gl in b.goals]  # type: ignore[arg-type]
     cache: dict[int, tuple[np.ndarray, ...]] = {}
 
     def state(k: int) -> tuple[np.ndarray, ...]:

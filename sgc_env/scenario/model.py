@@ -9,18 +9,26 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sgc_env.paper import quaternion as quat
 from sgc_env.paper.end_rules import DEFAULT_END_RULE
 
-__all__ = ["Body", "Goal", "Prop", "Quat", "Scenario", "ScenarioError", "Vec3", "grid_time"]
+__all__ = [
+    "Body", "Goal", "Prop", "Quat", "Scenario", "ScenarioError", "Vec3", "goal_orientations",
+    "grid_tick", "grid_time",
+]  # fmt: skip
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 
 
+def grid_tick(t: float, frequency: int) -> int:
+    """The control tick nearest to time ``t``: the one rounding of times to the grid."""
+    return round(t * frequency)
+
+
 def grid_time(t: float, frequency: int) -> float:
-    """``t`` rounded to the nearest control tick (an exact multiple of ``1 / frequency``): the
-    one rounding every goal time goes through."""
-    return round(t * frequency) / frequency
+    """``t`` rounded to the nearest control tick (an exact multiple of ``1 / frequency``)."""
+    return grid_tick(t, frequency) / frequency
 
 
 class ScenarioError(ValueError):
@@ -135,3 +143,22 @@ class Scenario:
             if b.name == name:
                 return i
         raise KeyError(f"no body named {name!r}")
+
+
+def goal_orientations(body: Body) -> list[Quat | None]:
+    """Per goal, the orientation (xyzw) it asks for, or None for a goal without one: an
+    absolute ``orientation`` as given, a ``relative_rotation`` ``r`` as ``Exp(r)`` applied to
+    the previous orientation goal's target (or to the initial orientation). The one place
+    relative rotations become goal quaternions (plain floats, as the env's tracks)."""
+    out: list[Quat | None] = []
+    previous: Quat = body.orientation
+    for g in body.goals:
+        if g.relative_rotation is not None:
+            previous = quat.mul(quat.exp_normalized(g.relative_rotation), previous)
+        elif g.orientation is not None:
+            previous = g.orientation
+        else:
+            out.append(None)
+            continue
+        out.append(previous)
+    return out

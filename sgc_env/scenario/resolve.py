@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
@@ -17,7 +16,7 @@ from sgc_env.paper import quaternion as quat
 from sgc_env.paper.routing import resolve_goal_times
 from sgc_env.scenario.demand import check_plan as _check_plan
 from sgc_env.scenario.fields import MAX_EPISODE_STEPS, fail
-from sgc_env.scenario.model import Body, Goal, Scenario, grid_time
+from sgc_env.scenario.model import Body, Goal, Scenario, goal_orientations, grid_tick, grid_time
 from sgc_env.scenario.validate import check_inside, validate_structure
 
 __all__ = ["resolve_scenario"]
@@ -55,7 +54,8 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
     distances: list[float] = []
     weights: list[float] = []
     prev_point: np.ndarray | None = None
-    prev_q: Any = np.asarray(b.orientation, float)
+    prev_q = b.orientation
+    targets = goal_orientations(b)
     for j, g in enumerate(b.goals):
         gp = f"{p}.goals[{j}]"
         crit = g.is_critical
@@ -80,13 +80,11 @@ def _body_goal_times(b: Body, s: Scenario, freq: int, mode: str, p: str) -> list
                 prev_point = np.asarray(b.position, float) + quat.rotate(b.orientation, g.point)
             dist = float(np.linalg.norm(nail - prev_point)) if nail is not None else 0.0
             prev_point = nail
-        if g.has_orientation:
-            q: Any
+        q = targets[j]
+        if q is not None:
             if g.relative_rotation is not None:
                 angle = float(np.linalg.norm(g.relative_rotation))
-                q = quat.mul(quat.exp_normalized(g.relative_rotation), prev_q)
             else:
-                q = np.asarray(g.orientation, float)
                 angle = _rotation_angle(prev_q, q)
             prev_q = q
             if not g.has_position:
@@ -162,7 +160,7 @@ def resolve_scenario(
             goals.append(replace(g, time=t, critical=g.is_critical, nail=nail))
         bodies.append(replace(b, goals=tuple(goals)))
     out = replace(s, bodies=tuple(bodies), resolved=True)
-    last = max(round(float(g.time) * s.control_frequency) for b in bodies for g in b.goals)  # type: ignore[arg-type]
+    last = max(grid_tick(float(g.time), s.control_frequency) for b in bodies for g in b.goals)  # type: ignore[arg-type]
     steps = last + math.ceil(s.margin * s.control_frequency - 1e-9)
     if steps > MAX_EPISODE_STEPS:
         raise fail(
