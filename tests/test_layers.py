@@ -1,10 +1,18 @@
-"""The layers run one way: sgc_env (env, scenarios, the paper's math) <- baselines <- the CLI."""
+"""The layers run one way: sgc_env (env, scenarios, the paper's math) <- baselines <- the CLI.
+
+Every import counts, at any depth: module level, inside functions and under
+``TYPE_CHECKING`` (read with ``ast``, nothing is imported). Checked: no import circle between
+the modules of ``sgc_env`` and ``baselines``; between their parts (``sgc_env.scenario``,
+``baselines.agents``, ...) imports run down the order of :data:`LAYERS` only; at most eight
+loose modules at the top of ``sgc_env``; no module over 600 lines.
+"""
 
 from __future__ import annotations
 
 import ast
 import subprocess
 import sys
+from collections.abc import Iterable
 from pathlib import Path
 
 import pytest
@@ -68,3 +76,182 @@ def test_the_detector_sees_a_lazy_upward_import(tmp_path):
 def test_every_module_opens_with_a_docstring(path):
     doc = ast.get_docstring(ast.parse(path.read_text(), filename=str(path)))
     assert doc and doc.strip(), f"{path.relative_to(ROOT)} has no module docstring"
+
+
+# ---------------------------------------------------------------- the module graph
+
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("sgc_env.paper", "sgc_env.defaults"),
+    ("sgc_env.scenario",),
+    ("sgc_env.scenes",),
+    ("sgc_env.episode_steps", "sgc_env.observation", "sgc_env.simulator", "sgc_env.metrics"),
+    ("sgc_env.rendering",),
+    ("sgc_env.envs",),
+    ("sgc_env",),  # the package: registers the ids
+    ("sgc_env.ladder",),
+    ("baselines.vector", "baselines.observation_fields", "baselines.minimum_jerk",
+     "baselines.tracking", "baselines.dynamic_constraints", "baselines.shipped"),
+    ("baselines.env_model",),
+    ("baselines.actuation",),
+    ("baselines.expert",),
+    ("baselines.comparison_policies",),
+    ("baselines.policies", "baselines"),
+    ("baselines.evaluation",),
+    ("baselines.agents",),
+    ("baselines.benchmark",),
+    ("baselines.cli",),
+)  # fmt: skip
+"""The parts of ``sgc_env`` and ``baselines``, bottom up: a part imports only parts of lower
+rows (and itself)."""
+
+KNOWN_CIRCLES: set[frozenset[str]] = {
+    frozenset({"sgc_env.envs.rewards", "sgc_env.envs.task"}),  # fixed on branch vec
+}
+"""Module pairs whose circle is known and being removed elsewhere."""
+
+KNOWN_LONG_MODULES = {
+    "sgc_env/envs/sgc_env.py",  # split on branch vec (actuation out of step and _commit)
+    "sgc_env/paper/course.py",  # shrunk on branch smooth
+}
+MAX_LINES = 600
+MAX_LOOSE_MODULES = 8
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES: dict[str, Path] = {
+    _module_name(p): p for package in ("sgc_env", "baselines") for p in _modules(package)
+}
+
+
+def _edges(name: str, path: Path, known: Iterable[str]) -> set[str]:
+    """The modules of ``known`` that module ``name`` imports, relative imports resolved and
+    ``from package import submodule`` read as the submodule."""
+    known = set(known)
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            out.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[: len(parts) - node.level + 1] + ([base] if base else []))
+            for alias in node.names:
+                full = f"{base}.{alias.name}"
+                out.add(full if full in known else base)
+    return {m for m in out if m in known and m != name}
+
+
+GRAPH: dict[str, set[str]] = {n: _edges(n, p, MODULES) for n, p in MODULES.items()}
+
+
+def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def _without_known(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    return {a: {b for b in bs if frozenset({a, b}) not in KNOWN_CIRCLES} for a, bs in graph.items()}
+
+
+def _part(module: str) -> str:
+    """The part of :data:`LAYERS` a module belongs to (its longest listed prefix)."""
+    names = [n for row in LAYERS for n in row if module == n or module.startswith(n + ".")]
+    assert names, f"{module} is in no row of LAYERS: add it"
+    return max(names, key=len)
+
+
+def _row(part: str) -> int:
+    return next(i for i, row in enumerate(LAYERS) if part in row)
+
+
+def test_no_import_circle_in_sgc_env_or_baselines():
+    assert _circles(_without_known(GRAPH)) == []
+
+
+def test_known_circles_are_still_there():
+    """Drop an entry of KNOWN_CIRCLES once its circle is gone."""
+    for pair in KNOWN_CIRCLES:
+        assert pair in map(frozenset, _circles({m: GRAPH[m] & pair for m in pair})), pair
+
+
+def test_imports_run_down_the_layers():
+    upward = sorted(
+        f"{a} -> {b}"
+        for a, bs in GRAPH.items()
+        for b in bs
+        if _part(a) != _part(b) and _row(_part(b)) > _row(_part(a))
+    )
+    assert upward == []
+
+
+def test_every_module_has_a_layer():
+    for module in MODULES:
+        _part(module)
+
+
+def test_the_detector_sees_circles_through_functions_and_type_checking(tmp_path):
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "__init__.py").write_text("")
+    (tmp_path / "pkg" / "a.py").write_text("def f():\n    from pkg.b import g\n")
+    (tmp_path / "pkg" / "b.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from . import a\n"
+    )
+    known = {"pkg", "pkg.a", "pkg.b"}
+    graph = {
+        "pkg.a": _edges("pkg.a", tmp_path / "pkg" / "a.py", known),
+        "pkg.b": _edges("pkg.b", tmp_path / "pkg" / "b.py", known),
+    }
+    assert graph == {"pkg.a": {"pkg.b"}, "pkg.b": {"pkg.a"}}
+    assert _circles(graph) == [["pkg.a", "pkg.b"]]
+
+
+def test_at_most_eight_loose_modules_at_the_top_of_sgc_env():
+    loose = sorted(p.name for p in (ROOT / "sgc_env").glob("*.py") if p.name != "__init__.py")
+    assert len(loose) <= MAX_LOOSE_MODULES, loose
+
+
+@pytest.mark.parametrize(
+    "path", _modules("sgc_env") + _modules("baselines"), ids=lambda p: str(p.relative_to(ROOT))
+)
+def test_no_module_over_600_lines(path):
+    lines = len(path.read_text().splitlines())
+    name = str(path.relative_to(ROOT))
+    if name in KNOWN_LONG_MODULES and lines > MAX_LINES:
+        pytest.xfail(f"{name}: {lines} lines, being split on another branch")
+    assert lines <= MAX_LINES, f"{name}: {lines} lines"
