@@ -2,7 +2,7 @@
 
 Every PyBullet call of the environment package goes through here (the env, its task and the
 rendering helpers never import pybullet). Facts this module relies on (PyBullet 3.2.7, see
-method-notes): createMultiBody bodies get damping 0.04 by default, so it is switched off;
+docs/core.md): createMultiBody bodies get damping 0.04 by default, so it is switched off;
 external forces last a single simulation step, so they are re-applied on every substep; Python
 API calls dominate the cost, so the hot path (:meth:`Simulator.step_bodies`,
 :meth:`Simulator.body_states`) uses cached ids and bound calls.

@@ -255,3 +255,26 @@ def test_no_module_over_600_lines(path):
     if name in KNOWN_LONG_MODULES and lines > MAX_LINES:
         pytest.xfail(f"{name}: {lines} lines, being split on another branch")
     assert lines <= MAX_LINES, f"{name}: {lines} lines"
+
+
+def _layout_table() -> str:
+    text = (ROOT / "docs" / "design.md").read_text()
+    return text[text.index("## Layout") : text.index("## Conventions")]
+
+
+@pytest.mark.parametrize(
+    "path",
+    [p for p in _modules("sgc_env") if p.name not in ("__init__.py", "__main__.py")]
+    + [p for p in (ROOT / "baselines").glob("*.py") if p.name != "__init__.py"],
+    ids=lambda p: str(p.relative_to(ROOT)),
+)
+def test_the_design_layout_table_names_every_module(path):
+    """docs/design.md's layout lists each module, by path or by name next to its folder's."""
+    table = _layout_table()
+    rel = str(path.relative_to(ROOT))
+    assert rel in table or f"`{path.name}`" in table, f"{rel} is missing from docs/design.md"
+
+
+def test_the_docs_link_nothing_outside_the_repository():
+    for doc in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        assert "../shared" not in doc.read_text(), doc.name
