@@ -1,5 +1,7 @@
 """Fuzzing scenario dictionaries: every draw loads and the expert meets its goals, or the
-loader raises ScenarioError. Nothing else is allowed (no other exception, no hang).
+loader raises ScenarioError. Nothing else is allowed (no other exception, no hang). Raw YAML
+text is fuzzed too (a shipped file with hostile edits, and any text): only a ScenarioError or
+a scenario may come out.
 
 Draws are one-body scenes (two bodies could collide, which no validation can rule out) built
 from mostly sensible values with hostile ones mixed in: huge, tiny, NaN, inf, wrong types.
@@ -22,6 +24,7 @@ from baselines import SGCExpert  # noqa: E402
 from baselines.evaluation import run_episode  # noqa: E402
 from sgc_env.envs import SGCEnv  # noqa: E402
 from sgc_env.scenario import ScenarioError, resolve_scenario, scenario_from_dict  # noqa: E402
+from sgc_env.scenario.load import builtin_path, scenario_from_yaml  # noqa: E402
 
 HOSTILE = st.sampled_from(
     [0.0, -1.0, 1e-300, 1e-17, 1e6, 1e300, -1e300, math.nan, math.inf, -math.inf, "1e0", None]
@@ -114,3 +117,71 @@ def test_fuzzed_scenarios_load_and_are_met_or_are_rejected(data):
 @given(scenarios())
 def test_fuzzed_scenarios_many(data):
     check(data)
+
+
+# ---------------------------------------------------------------- raw YAML text
+
+SEED_TEXT = builtin_path("point_three_goals").read_text(encoding="utf-8")
+TOKENS = [
+    "nan", ".nan", ".inf", "-.inf", "1e400", "9" * 400, "-" + "9" * 5000, "0x1F", "1_0", "[",
+    "]", "{", "}", "null", "~", "true", "yes", "'", '"', "\t", "\x00", "\ufeff", "- ", ": ",
+    "? ", "&a [*a]", "*a", "<<: *a", "!!python/object/apply:os.system ['true']", "!!binary x",
+    "!!set {a}", "%YAML 1.1\n---\n", "\n---\n", "#", "|\n  x", ">-", "@", "`", "1e0", "-0",
+]  # fmt: skip
+
+
+@st.composite
+def yaml_texts(draw) -> str:
+    """The shipped point scenario with a few edits: cuts, repeats and hostile tokens."""
+    text = SEED_TEXT
+    for _ in range(draw(st.integers(1, 4))):
+        i = draw(st.integers(0, len(text)))
+        j = draw(st.integers(i, min(len(text), i + 12)))
+        edit = draw(st.sampled_from(["cut", "token", "text", "repeat"]))
+        if edit == "cut":
+            text = text[:i] + text[j:]
+        elif edit == "token":
+            text = text[:i] + draw(st.sampled_from(TOKENS)) + text[j:]
+        elif edit == "text":
+            text = text[:i] + draw(st.text(max_size=6)) + text[j:]
+        else:
+            text = text[:i] + text[i:j] * draw(st.integers(2, 50)) + text[j:]
+    return text
+
+
+def load_text(text: str) -> None:
+    """Only a ScenarioError (or a scenario) may come out."""
+    try:
+        scenario_from_yaml(text, "fuzz")
+    except ScenarioError:
+        pass
+
+
+@settings(max_examples=150, deadline=timedelta(seconds=5), derandomize=True)
+@given(yaml_texts())
+def test_edited_yaml_text_loads_or_is_refused(text):
+    load_text(text)
+
+
+@settings(max_examples=60, deadline=timedelta(seconds=5), derandomize=True)
+@given(st.text(max_size=60))
+def test_any_text_loads_or_is_refused(text):
+    load_text(text)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "&a [*a]",
+        "bodies: &a [*a]",
+        "bodies: [{name: b, goals: &g [{nail: *g, time: 1}]}]",
+        "bodies: [{name: b, goals: [{nail: [0, 0, " + "9" * 5000 + "], time: 1}]}]",
+        "bodies: [{name: " + "9" * 5000 + ", goals: [{nail: [0, 0, 1], time: 1}]}]",
+        "control_frequency: " + "9" * 5000 + "\nbodies: [{name: b, goals: [{nail: [0,0,1]}]}]",
+        "bodies: [{name: b, shape: [rod], goals: [{nail: [0, 0, 1], time: 1}]}]",
+        "{1: 2, null: 3, a: 4}",
+    ],
+)
+def test_hostile_yaml_is_a_scenario_error(text):
+    with pytest.raises(ScenarioError):
+        scenario_from_yaml(text, "hostile")

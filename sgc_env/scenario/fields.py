@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from typing import Any
 
 import numpy as np
@@ -17,10 +18,10 @@ import numpy as np
 from sgc_env.scenario.model import Quat, ScenarioError
 
 __all__ = [
-    "LIMITS", "MAX_EPISODE_STEPS", "MAX_GOALS", "MAX_HELIX_TURNS", "MAX_PATH_SAMPLES",
-    "MAX_WAYPOINTS", "SHAPES", "TIME_GRID_MODES", "WORKSPACE_LIMIT", "check_keys",
-    "coords_in_range", "fail", "in_range", "limit_text", "mapping", "norm_in_range", "number",
-    "quaternion", "require", "vector",
+    "FIELDS", "LIMITS", "MAX_EPISODE_STEPS", "MAX_GOALS", "MAX_HELIX_TURNS", "MAX_PATH_SAMPLES",
+    "MAX_WAYPOINTS", "PATH_GOAL_KEYS", "SHAPES", "TIME_GRID_MODES", "WORKSPACE_LIMIT", "check_keys",
+    "as_float", "coords_in_range", "fail", "field_keys", "in_range", "limit_text", "mapping",
+    "norm_in_range", "number", "quaternion", "require", "show", "vector",
 ]  # fmt: skip
 
 SHAPES: dict[str, tuple[str, ...]] = {
@@ -35,6 +36,79 @@ MAX_PATH_SAMPLES = 1_000
 MAX_GOALS = 10_000  # per body
 MAX_WAYPOINTS = 10_000  # per prop
 MAX_HELIX_TURNS = 1_000
+
+FIELDS: dict[str, str] = {
+    "name": "text",
+    "bodies": "list",
+    "props": "list?",
+    "goals": "mapping?",
+    "gravity": "vec3",
+    "workspace": "mapping",
+    "workspace.low": "vec3",
+    "workspace.high": "vec3",
+    "margin": "number",
+    "control_frequency": "integer",
+    "time_grid": "choice",
+    "allow_saturation": "flag",
+    "end_velocity_rule": "choice",
+    "bodies[]": "mapping",
+    "bodies[].name": "text",
+    "bodies[].shape": "choice",
+    "bodies[].size": "size",
+    "bodies[].mass": "number",
+    "bodies[].position": "vec3",
+    "bodies[].orientation": "quat",
+    "bodies[].linear_velocity": "vec3",
+    "bodies[].angular_velocity": "vec3",
+    "bodies[].color": "color",
+    "bodies[].force_limit": "number",
+    "bodies[].torque_limit": "number",
+    "bodies[].goals": "list",
+    "bodies[].end_velocity": "vec3?",
+    "bodies[].end_angular_velocity": "vec3?",
+    "bodies[].collisions": "flag",
+    "bodies[].goals[]": "mapping",
+    "bodies[].goals[].nail": "vec3",
+    "bodies[].goals[].point": "vec3",
+    "bodies[].goals[].orientation": "quat?",
+    "bodies[].goals[].relative_rotation": "vec3?",
+    "bodies[].goals[].time": "number?",
+    "bodies[].goals[].critical": "flag?",
+    "bodies[].goals[].weight": "number",
+    "bodies[].goals[].path": "mapping",
+    "bodies[].goals[].samples": "integer",
+    "props[]": "mapping",
+    "props[].name": "text",
+    "props[].shape": "choice",
+    "props[].size": "size",
+    "props[].color": "color",
+    "props[].position": "vec3",
+    "props[].velocity": "vec3",
+    "props[].waypoints": "list",
+    "props[].collisions": "flag",
+    "props[].waypoints[]": "mapping",
+    "props[].waypoints[].time": "number",
+    "props[].waypoints[].position": "vec3",
+}
+"""Every field a scenario file may hold, by path (``[]``: any list item), and its kind:
+``text``, ``choice`` (one of some names), ``number``, ``integer``, ``flag`` (true/false),
+``vec3``, ``quat``, ``color`` (3 or 4 numbers), ``size`` (a number or a list), ``list``,
+``mapping``; ``?`` allows null. The parser takes each mapping's keys from here and the tests
+generate a wrong value of every type for every field from it. A goal with a ``path`` is a
+point-to-path goal (``path``, ``samples``, ``point``, ``time``, ``weight``); a ``nail`` may
+also be ``{prop: name}`` (interception)."""
+
+PATH_GOAL_KEYS = frozenset({"path", "samples", "point", "time", "weight"})
+
+
+def field_keys(parent: str) -> frozenset[str]:
+    """The keys :data:`FIELDS` allows in the mapping at ``parent`` (``""``: the scenario)."""
+    prefix = f"{parent}." if parent else ""
+    return frozenset(
+        p[len(prefix) :] for p in FIELDS if p.startswith(prefix) and "." not in p[len(prefix) :]
+        and not p.endswith("[]")
+    )  # fmt: skip
+
 
 LIMITS: dict[str, tuple[float, float, str, str]] = {
     "mass": (1e-6, 1e6, "kg",
@@ -73,15 +147,33 @@ def fail(path: str, msg: str) -> ScenarioError:
 def number(value: Any, path: str, *, positive: bool = False, nonneg: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         kind = "a positive number" if positive else "a number"
-        raise fail(path, f"expected {kind}, got {value!r}{quoted_hint(value)}")
-    v = float(value)
+        raise fail(path, f"expected {kind}, got {show(value)}{quoted_hint(value)}")
+    v = as_float(value, path)
     if not math.isfinite(v):
-        raise fail(path, f"expected a finite number, got {value!r}")
+        raise fail(path, f"expected a finite number, got {show(value)}")
     if positive and v <= 0:
         raise fail(path, f"expected a positive number, got {v!r}")
     if nonneg and v < 0:
         raise fail(path, f"expected a number >= 0, got {v!r}")
     return v
+
+
+def as_float(value: float | np.floating | np.integer, path: str) -> float:
+    """``float(value)``, or a ScenarioError for an integer too large for a float."""
+    try:
+        return float(value)
+    except OverflowError:
+        raise fail(
+            path, f"{show(value)} is too large for a number (at most about 1.8e308)"
+        ) from None
+
+
+def show(value: Any) -> str:
+    """``repr(value)``, but an integer of hundreds of digits as its size (Python refuses to
+    print integers of more than 4300 digits)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**20:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    return repr(value)
 
 
 def quoted_hint(value: Any) -> str:
@@ -97,14 +189,16 @@ def quoted_hint(value: Any) -> str:
 
 def vector(value: Any, n: int, path: str) -> tuple[float, ...]:
     if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
-        raise fail(path, f"expected a list of {n} numbers, got {value!r}")
+        raise fail(path, f"expected a list of {n} numbers, got {show(value)}")
     if len(value) != n:
         raise fail(path, f"expected {n} numbers, got {len(value)}")
     out = []
     for x in value:
         if isinstance(x, bool) or not isinstance(x, int | float | np.floating | np.integer):
-            raise fail(path, f"expected {n} numbers, got {list(value)!r}{quoted_hint(x)}")
-        out.append(float(x))
+            raise fail(
+                path, f"expected {n} numbers, got [{', '.join(map(show, value))}]{quoted_hint(x)}"
+            )
+        out.append(as_float(x, path))
     if any(math.isnan(x) for x in out):
         raise fail(path, "contains NaN")
     if any(math.isinf(x) for x in out):
@@ -128,8 +222,8 @@ def mapping(value: Any, path: str) -> Mapping[str, Any]:
     return value
 
 
-def check_keys(d: Mapping[str, Any], allowed: set[str], path: str) -> None:
-    unknown = sorted(set(d) - allowed)
+def check_keys(d: Mapping[str, Any], allowed: AbstractSet[str], path: str) -> None:
+    unknown = sorted(set(d) - allowed, key=str)  # YAML keys may be numbers or null
     if unknown:
         raise fail(path, f"unknown field(s) {unknown}; expected some of {sorted(allowed)}")
 
@@ -150,7 +244,7 @@ def in_range(value: float, key: str, path: str) -> float:
     """``value`` inside ``LIMITS[key]``, else a message with the bound and its reason."""
     lo, hi, unit, _ = LIMITS[key]
     if not lo <= value <= hi:
-        raise fail(path, f"{value!r} is outside {limit_text(key)}")
+        raise fail(path, f"{show(value)} is outside {limit_text(key)}")
     return value
 
 

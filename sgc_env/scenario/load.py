@@ -21,7 +21,7 @@ from sgc_env.scenario.resolve import resolve_scenario
 
 __all__ = [
     "BUILTIN_DIR", "builtin_data", "builtin_path", "builtin_scenarios", "load_scenario",
-    "read_yaml",
+    "read_yaml", "scenario_from_yaml",
 ]  # fmt: skip
 
 BUILTIN_DIR = "builtin"
@@ -64,6 +64,8 @@ def read_yaml(text: str, name: str) -> Any:
         raise ScenarioError(f"{name}: not valid YAML: {exc}") from None
     except RecursionError:
         raise ScenarioError(f"{name}: nested too deeply to read") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise ScenarioError(f"{name}: not valid YAML: {exc}") from None
 
 
 def builtin_data(name: str) -> Any:
@@ -83,14 +85,21 @@ def load_scenario(path_or_name: str | Path | Scenario) -> Scenario:
         return resolve_scenario(path_or_name)
     path = Path(path_or_name)
     if path.suffix in (".yaml", ".yml") and path.exists():
-        name = path.stem
-        data = read_yaml(_read_text(path), name)
-    else:
-        name = str(path_or_name)
-        data = builtin_data(name)
+        return scenario_from_yaml(_read_text(path), path.stem)
+    name = str(path_or_name)
+    return _resolved(builtin_data(name), name)
+
+
+def scenario_from_yaml(text: str, name: str = "scenario") -> Scenario:
+    """The resolved scenario written in YAML ``text``; any fault is a ScenarioError that names
+    ``name`` or the field."""
+    return _resolved(read_yaml(text, name), name)
+
+
+def _resolved(data: Any, name: str) -> Scenario:
     try:
         return resolve_scenario(scenario_from_dict(data, name=name))
-    except RecursionError:
+    except RecursionError:  # a YAML alias can make a list that contains itself
         raise ScenarioError(f"{name}: nested too deeply to read") from None
 
 

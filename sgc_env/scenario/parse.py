@@ -18,20 +18,25 @@ from sgc_env.scenario.fields import (
     MAX_HELIX_TURNS,
     MAX_PATH_SAMPLES,
     MAX_WAYPOINTS,
+    PATH_GOAL_KEYS,
     check_keys,
     fail,
+    field_keys,
     mapping,
     number,
     quaternion,
     require,
+    show,
     vector,
 )
 from sgc_env.scenario.model import Body, Goal, Prop, Scenario, ScenarioError
 
 __all__ = ["scenario_from_dict"]
 
-_GOAL_KEYS = {"nail", "point", "orientation", "relative_rotation", "time", "critical", "weight"}
-_PATH_KEYS = {"path", "samples", "point", "time", "weight"}
+_GOAL_KEYS = field_keys("bodies[].goals[]") - {"path", "samples"}
+_BODY_KEYS = field_keys("bodies[]")
+_PROP_KEYS = field_keys("props[]")
+_SCENARIO_KEYS = field_keys("")
 
 
 def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
@@ -44,7 +49,7 @@ def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
         p = f"{path}[{j}]"
         g = mapping(g, p)
         if "path" in g:
-            check_keys(g, _PATH_KEYS, p)
+            check_keys(g, PATH_GOAL_KEYS, p)
             goals.extend(_parse_path_goal(g, p))
             continue
         check_keys(g, _GOAL_KEYS, p)
@@ -59,7 +64,7 @@ def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
         time = None if g.get("time") is None else number(g["time"], f"{p}.time")
         critical = g.get("critical")
         if critical is not None and not isinstance(critical, bool):
-            raise fail(f"{p}.critical", f"expected true or false, got {critical!r}")
+            raise fail(f"{p}.critical", f"expected true or false, got {show(critical)}")
         goals.append(
             Goal(
                 nail=nail,  # type: ignore[arg-type]
@@ -84,7 +89,7 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
     kind = require(spec, "curve", f"{p}.path")
     samples = require(g, "samples", p)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-        raise fail(f"{p}.samples", f"expected an integer >= 1, got {samples!r}")
+        raise fail(f"{p}.samples", f"expected an integer >= 1, got {show(samples)}")
     if samples > MAX_PATH_SAMPLES:
         raise fail(
             f"{p}.samples",
@@ -95,14 +100,14 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
     turns = spec.get("turns")
     if isinstance(turns, int | float) and not isinstance(turns, bool):
         if not abs(turns) <= MAX_HELIX_TURNS:
-            raise fail(f"{p}.path.turns", f"{turns!r}: at most {MAX_HELIX_TURNS} turns")
+            raise fail(f"{p}.path.turns", f"{show(turns)}: at most {MAX_HELIX_TURNS} turns")
     try:
         curve = parametric_curve(str(kind), **spec)
         pts = np.asarray([curve(s) for s in (0.0, 0.5, 1.0)], float)
     except ScenarioError as exc:
         raise fail(f"{p}.path.curve", str(exc)) from None
     except (KeyError, TypeError, ValueError) as exc:
-        raise fail(f"{p}.path", f"bad parameters for curve {kind!r}: {exc}") from None
+        raise fail(f"{p}.path", f"bad parameters for curve {show(kind)}: {exc}") from None
     if not np.all(np.isfinite(pts)):
         raise fail(f"{p}.path", "curve gives non-finite points")
     time = None if g.get("time") is None else number(g["time"], f"{p}.time")
@@ -115,39 +120,30 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
     )
 
 
-_BODY_KEYS = {
-    "name", "shape", "size", "mass", "position", "orientation", "linear_velocity",
-    "angular_velocity", "color", "force_limit", "torque_limit", "goals", "end_velocity",
-    "end_angular_velocity", "collisions",
-}  # fmt: skip
-_PROP_KEYS = {"name", "shape", "size", "color", "position", "velocity", "waypoints", "collisions"}
-_SCENARIO_KEYS = {
-    "name", "bodies", "props", "goals", "gravity", "workspace", "margin", "control_frequency",
-    "time_grid", "allow_saturation", "end_velocity_rule",
-}  # fmt: skip
-
-
 def _size(value: Any, path: str) -> tuple[float, ...]:
     if isinstance(value, int | float) and not isinstance(value, bool):
         value = [value]
     if not isinstance(value, list | tuple):
-        raise fail(path, f"expected a list of numbers, got {value!r}")
+        raise fail(path, f"expected a list of numbers, got {show(value)}")
     return tuple(number(v, f"{path}[{i}]") for i, v in enumerate(value))
+
+
+def _name(value: Any, path: str) -> str:
+    if not isinstance(value, str) or not value:
+        raise fail(path, f"expected a non-empty string, got {show(value)}")
+    return value
 
 
 def _bool(value: Any, path: str) -> bool:
     if not isinstance(value, bool):
-        raise fail(path, f"expected true or false, got {value!r}")
+        raise fail(path, f"expected true or false, got {show(value)}")
     return value
 
 
 def _parse_body(d: Any, path: str) -> Body:
     d = mapping(d, path)
     check_keys(d, _BODY_KEYS, path)
-    name = require(d, "name", path)
-    if not isinstance(name, str) or not name:
-        raise fail(f"{path}.name", f"expected a non-empty string, got {name!r}")
-    kw: dict[str, Any] = {"name": name}
+    kw: dict[str, Any] = {"name": _name(require(d, "name", path), f"{path}.name")}
     if "shape" in d:
         kw["shape"] = d["shape"]
     if "size" in d:
@@ -181,7 +177,7 @@ def _color(value: Any, path: str) -> tuple[float, float, float, float]:
 def _parse_prop(d: Any, path: str) -> Prop:
     d = mapping(d, path)
     check_keys(d, _PROP_KEYS, path)
-    kw: dict[str, Any] = {"name": require(d, "name", path)}
+    kw: dict[str, Any] = {"name": _name(require(d, "name", path), f"{path}.name")}
     if "shape" in d:
         kw["shape"] = d["shape"]
     if "size" in d:
@@ -203,7 +199,7 @@ def _parse_prop(d: Any, path: str) -> Prop:
         for i, w in enumerate(wps):
             wp = f"{path}.waypoints[{i}]"
             w = mapping(w, wp)
-            check_keys(w, {"time", "position"}, wp)
+            check_keys(w, field_keys("props[].waypoints[]"), wp)
             out.append(
                 (
                     number(require(w, "time", wp), f"{wp}.time"),
@@ -227,7 +223,9 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
         names = [b.name for b in bodies]
         for body_name, goal_list in extra.items():
             if body_name not in names:
-                raise fail("goals", f"goals refer to unknown body {body_name!r}; bodies: {names}")
+                raise fail(
+                    "goals", f"goals refer to unknown body {show(body_name)}; bodies: {names}"
+                )
             i = names.index(body_name)
             new = _parse_goals(goal_list, f"goals.{body_name}")
             bodies[i] = replace(bodies[i], goals=bodies[i].goals + new)
@@ -237,13 +235,13 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
     kw: dict[str, Any] = {
         "bodies": tuple(bodies),
         "props": tuple(_parse_prop(p, f"props[{i}]") for i, p in enumerate(props_raw)),
-        "name": str(d.get("name", name or "scenario")),
+        "name": _name(d["name"], "name") if "name" in d else (name or "scenario"),
     }
     if "gravity" in d:
         kw["gravity"] = vector(d["gravity"], 3, "gravity")
     if "workspace" in d:
         ws = mapping(d["workspace"], "workspace")
-        check_keys(ws, {"low", "high"}, "workspace")
+        check_keys(ws, field_keys("workspace"), "workspace")
         kw["workspace"] = (
             vector(require(ws, "low", "workspace"), 3, "workspace.low"),
             vector(require(ws, "high", "workspace"), 3, "workspace.high"),
@@ -253,7 +251,7 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
     if "control_frequency" in d:
         cf = d["control_frequency"]
         if isinstance(cf, bool) or not isinstance(cf, int) or cf <= 0:
-            raise fail("control_frequency", f"expected a positive integer (Hz), got {cf!r}")
+            raise fail("control_frequency", f"expected a positive integer (Hz), got {show(cf)}")
         kw["control_frequency"] = cf
     if "time_grid" in d:
         kw["time_grid"] = d["time_grid"]

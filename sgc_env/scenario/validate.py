@@ -23,6 +23,7 @@ from sgc_env.scenario.fields import (
     norm_in_range,
     number,
     quaternion,
+    show,
     vector,
 )
 from sgc_env.scenario.model import Goal, Scenario, Vec3
@@ -42,11 +43,15 @@ def validate_structure(s: Scenario) -> None:
     if not s.bodies:
         raise fail("bodies", "expected at least one body")
     if s.time_grid not in TIME_GRID_MODES:
-        raise fail("time_grid", f"expected one of {TIME_GRID_MODES}, got {s.time_grid!r}")
+        raise fail("time_grid", f"expected one of {TIME_GRID_MODES}, got {show(s.time_grid)}")
     if s.end_velocity_rule not in END_RULES:
-        raise fail("end_velocity_rule", f"expected one of {END_RULES}, got {s.end_velocity_rule!r}")
+        raise fail(
+            "end_velocity_rule", f"expected one of {END_RULES}, got {show(s.end_velocity_rule)}"
+        )
     if not (isinstance(s.control_frequency, int) and s.control_frequency > 0):
-        raise fail("control_frequency", f"expected a positive integer, got {s.control_frequency!r}")
+        raise fail(
+            "control_frequency", f"expected a positive integer, got {show(s.control_frequency)}"
+        )
     in_range(s.control_frequency, "control_frequency", "control_frequency")
     norm_in_range(vector(s.gravity, 3, "gravity"), "gravity", "gravity")
     lo, hi = (
@@ -59,13 +64,13 @@ def validate_structure(s: Scenario) -> None:
         raise fail("workspace", f"must lie inside +-{WORKSPACE_LIMIT:g} m, got {lo} .. {hi}")
     in_range(number(s.margin, "margin", nonneg=True), "margin", "margin")
     if not isinstance(s.allow_saturation, bool):
-        raise fail("allow_saturation", f"expected true or false, got {s.allow_saturation!r}")
+        raise fail("allow_saturation", f"expected true or false, got {show(s.allow_saturation)}")
     names: set[str] = set()
     prop_names = {p.name for p in s.props}
     for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
         if b.name in names or b.name in prop_names:
-            raise fail(f"{p}.name", f"duplicate name {b.name!r}")
+            raise fail(f"{p}.name", f"duplicate name {show(b.name)}")
         names.add(b.name)
         _validate_shape(b.shape, b.size, p)
         _validate_color(b.color, f"{p}.color")
@@ -94,7 +99,7 @@ def validate_structure(s: Scenario) -> None:
     for i, pr in enumerate(s.props):
         p = f"props[{i}]"
         if not isinstance(pr.name, str) or not pr.name or pr.name in seen:
-            raise fail(f"{p}.name", f"expected a unique non-empty string, got {pr.name!r}")
+            raise fail(f"{p}.name", f"expected a unique non-empty string, got {show(pr.name)}")
         seen.add(pr.name)
         _validate_shape(pr.shape, pr.size, p)
         _validate_color(pr.color, f"{p}.color")
@@ -107,7 +112,7 @@ def validate_structure(s: Scenario) -> None:
             wp = f"{p}.waypoints[{k}]"
             t = number(t, f"{wp}.time")
             if not abs(t) <= LIMITS["time"][1]:
-                raise fail(f"{wp}.time", f"{t!r} is outside +-{limit_text('time')}")
+                raise fail(f"{wp}.time", f"{show(t)} is outside +-{limit_text('time')}")
             if t <= last:
                 raise fail(f"{wp}.time", f"{t} is not after the previous time {last}")
             coords_in_range(vector(pos, 3, f"{wp}.position"), f"{wp}.position")
@@ -115,8 +120,8 @@ def validate_structure(s: Scenario) -> None:
 
 
 def _validate_shape(shape: Any, size: tuple[float, ...], p: str) -> None:
-    if shape not in SHAPES:
-        raise fail(f"{p}.shape", f"unknown shape {shape!r}; expected one of {sorted(SHAPES)}")
+    if not isinstance(shape, str) or shape not in SHAPES:
+        raise fail(f"{p}.shape", f"unknown shape {show(shape)}; expected one of {sorted(SHAPES)}")
     need = SHAPES[shape]
     if len(size) != len(need):
         raise fail(f"{p}.size", f"a {shape} needs {len(need)} numbers {need}, got {list(size)}")
@@ -145,7 +150,7 @@ def _validate_goal(
         vector(g.nail, 3, f"{p}.nail")
         check_inside(g.nail, ws, f"{p}.nail")
     if g.nail_prop is not None and g.nail_prop not in prop_names:
-        raise fail(f"{p}.nail.prop", f"refers to unknown prop {g.nail_prop!r}")
+        raise fail(f"{p}.nail.prop", f"refers to unknown prop {show(g.nail_prop)}")
     norm_in_range(vector(g.point, 3, f"{p}.point"), "point", f"{p}.point")
     if g.orientation is not None and g.relative_rotation is not None:
         raise fail(p, "give either orientation or relative_rotation, not both")
@@ -156,7 +161,7 @@ def _validate_goal(
         norm_in_range(rel, "relative_rotation", f"{p}.relative_rotation")
     w = number(g.weight, f"{p}.weight")
     if w <= 0:
-        raise fail(f"{p}.weight", f"routing weight must be > 0, got {w!r}")
+        raise fail(f"{p}.weight", f"routing weight must be > 0, got {show(w)}")
     in_range(w, "weight", f"{p}.weight")
     if g.time is not None:
         t = number(g.time, f"{p}.time")
