@@ -1,4 +1,11 @@
-"""Reset cost of the random paper scenes against their fixed ids, measured in the same run.
+"""Reset cost of the random ids, and of the random paper scenes against their fixed ids, measured
+in the same run.
+
+First, for every id registered with a random scene family: the mean ``env.reset(seed=...)``
+time on the unwrapped env, its ratio to a bare PyBullet reset measured in the same run
+(one body of a DIRECT client put back to its start pose and velocity), and
+the redraw rate (feasibility checks per kept scene; ``-`` for families whose draw is feasible
+by construction and never checks). Then, as before:
 
 For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
 the unwrapped env, the ratio random / fixed, how many feasibility checks (``demand_bounds``
@@ -22,6 +29,33 @@ from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
          ("SGCThreeRods-v0", "SGCThreeRodsRandom-v0", "three_rods"))  # fmt: skip
+
+
+def _bare_reset_ms(resets: int) -> float:
+    """A bare PyBullet reset: one body of a DIRECT client put back to its start pose and
+    velocity (the least any reset does)."""
+    from sgc_env.simulator import pybullet as p
+
+    client = p.connect(p.DIRECT)
+    shape = p.createCollisionShape(p.GEOM_SPHERE, radius=0.05, physicsClientId=client)
+    body = p.createMultiBody(1.0, shape, physicsClientId=client)
+    start = time.perf_counter()
+    for k in range(resets):
+        p.resetBasePositionAndOrientation(body, (0, 0, k), (0, 0, 0, 1), physicsClientId=client)
+        p.resetBaseVelocity(body, (0, 0, 0), (0, 0, 0), physicsClientId=client)
+    elapsed = time.perf_counter() - start
+    p.disconnect(client)
+    return elapsed / resets * 1e3
+
+
+def _random_ids() -> list[tuple[str, str]]:
+    """Every registered id with a random family, and the family's preset name."""
+    out = []
+    for env_id in sgc_env.ENV_IDS:
+        preset = gym.spec(env_id).kwargs.get("random_scenario")
+        if isinstance(preset, str):
+            out.append((env_id, preset))
+    return out
 
 
 def _reset_ms(env_id: str, resets: int) -> float:
@@ -54,7 +88,7 @@ def _episode_ms(env_id: str, steps: int) -> float:
 
 
 def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
-    """Checks per kept scene, and the mean ms of one check."""
+    """Checks per kept scene, and the mean ms of one check (0 checks: nan)."""
     calls, seconds = [0], [0.0]
     check = intercept.demand_bounds
 
@@ -72,13 +106,22 @@ def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
             random_scenario(rng, family)
     finally:
         intercept.demand_bounds = three_rods_random.demand_bounds = check
-    return calls[0] / scenes, seconds[0] / calls[0] * 1e3
+    return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resets", type=int, default=20)
     args = parser.parse_args()
+    bare = _bare_reset_ms(2000)
+    print(f"bare PyBullet reset: {bare * 1e3:.1f} us")
+    print(f"{'id':24s} {'reset ms':>9s} {'x bare':>8s} {'checks/scene':>12s}")
+    for env_id, preset in _random_ids():
+        ms = _reset_ms(env_id, args.resets)
+        draws, _ = _draws_per_scene(preset, args.resets)
+        rate = f"{draws:12.2f}" if draws else f"{'-':>12s}"
+        print(f"{env_id:24s} {ms:9.2f} {ms / bare:8.0f} {rate}")
+    print()
     print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}"
           f" {'episode ms':>11s}")  # fmt: skip
     for fixed, random_id, family in PAIRS:
