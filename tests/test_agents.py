@@ -332,9 +332,11 @@ def test_behaviour_cloning_reduces_imitation_loss(tmp_path: Path, tiny_hp: Path)
     assert result.bc["loss_after"] < 0.5 * result.bc["loss_before"]
     assert result.bc["samples_after_dagger"] > len(demos)
     assert imitation_loss(result.model, demos) < result.bc["loss_before"]
+    import gymnasium as gym
+
     from baselines.policies import load_sb3_model
 
-    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip")
+    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip", env=gym.make("SGCPoint-v0"))
     obs = demos.observations[:5]
     np.testing.assert_allclose(
         reloaded.predict(obs, deterministic=True)[0],
@@ -531,5 +533,5 @@ def test_normalize_saves_statistics_and_evaluates_on_raw_observations(tmp_path: 
             out=out,
         )  # fmt: skip
     )
-    assert (out / "vecnormalize.pkl").is_file() and (out / "best_model.zip").is_file()
+    assert (out / "vecnormalize.json").is_file() and (out / "best_model.zip").is_file()
     assert result.evaluations and result.evaluations[-1]["n_goals"] >= 1

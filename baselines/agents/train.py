@@ -134,12 +134,17 @@ def _jsonable(value: Any) -> Any:
 def train(cfg: TrainConfig) -> TrainResult:
     """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
     import torch as th
-    from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CallbackList
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from baselines.agents.callbacks import FreezeActorCallback, HarnessEvalCallback
+    from baselines.agents.callbacks import (
+        FreezeActorCallback,
+        HarnessEvalCallback,
+        StatisticsCheckpointCallback,
+    )
     from baselines.agents.hyperparams import load_hyperparams
+    from baselines.normalization import save_statistics
 
     _validate(cfg)
     started = time.perf_counter()
@@ -175,7 +180,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         callbacks.append(FreezeActorCallback(cfg.critic_warmup))
     if out is not None and cfg.checkpoint_freq:
         callbacks.append(
-            CheckpointCallback(
+            StatisticsCheckpointCallback(
                 max(cfg.checkpoint_freq // hp.n_envs, 1), str(out / "checkpoints"),
                 name_prefix=cfg.algo, save_vecnormalize=hp.normalize,
             )
@@ -231,7 +236,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     if out is not None:
         result.model_path = Path(model.save(out / "final_model") or out / "final_model.zip")
         if hp.normalize:
-            env.save(str(out / "vecnormalize.pkl"))
+            save_statistics(env, out / "vecnormalize.json")
         (out / "config.json").write_text(json.dumps(_jsonable(config), indent=1))
     env.close()
     return result
@@ -268,8 +273,11 @@ def _clone(model: Any, cfg: TrainConfig) -> dict[str, Any]:
     return info
 
 
-def load_model(path: str | Path, env: Any | None = None, device: str = "cpu") -> Any:
-    """Load an SB3 ``.zip`` whatever algorithm wrote it (with ``env``, HER models too)."""
-    from baselines.policies import load_sb3_model
+def load_model(
+    path: str | Path, env: Any | None = None, device: str = "cpu", trust_model: bool = False
+) -> Any:
+    """Load an SB3 ``.zip`` whatever algorithm wrote it, without unpickling unless
+    ``trust_model`` (:mod:`baselines.model_files`; safe loading needs ``env``)."""
+    from baselines.model_files import load_sb3_model
 
-    return load_sb3_model(path, env=env, device=device)
+    return load_sb3_model(path, env=env, device=device, trust_model=trust_model)

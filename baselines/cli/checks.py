@@ -15,6 +15,7 @@ import json
 import math
 import os
 import shutil
+import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -22,6 +23,7 @@ from typing import Any
 
 __all__ = [
     "UsageError",
+    "add_trust_argument",
     "bounded_int",
     "env_kwargs",
     "existing_dir",
@@ -35,6 +37,7 @@ __all__ = [
     "positive_float",
     "positive_int",
     "staged_output",
+    "trust_model",
 ]
 
 
@@ -184,3 +187,23 @@ def staged_output(out: Path) -> Iterator[Path]:
             os.replace(src, dest)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def add_trust_argument(parser: argparse.ArgumentParser) -> None:
+    """``--trust-model``: load model files with SB3's unpickling (see baselines.model_files)."""
+    parser.add_argument(
+        "--trust-model", action="store_true",
+        help="unpickle model files (.zip fields, .vecnormalize.pkl) as SB3 does: a file can "
+        "run any code while it loads; only for files you made or trust. Default: load "
+        "without unpickling",
+    )  # fmt: skip
+
+
+def trust_model(args: argparse.Namespace, command: str) -> bool:
+    """``args.trust_model``, printing the risk to stderr when it is set."""
+    trust = bool(getattr(args, "trust_model", False))
+    if trust:
+        from baselines.model_files import TRUST_WARNING
+
+        print(f"sgc {command}: warning: {TRUST_WARNING}", file=sys.stderr)
+    return trust
