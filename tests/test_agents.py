@@ -373,6 +373,9 @@ def test_train_command_runs(tmp_path: Path, tiny_hp: Path) -> None:
     )  # fmt: skip
     assert train_command.run(args) == 0
     assert (tmp_path / "run" / "final_model.zip").is_file()
+    config = json.loads((tmp_path / "run" / "config.json").read_text())
+    assert config["train_config"]["out"] == str(tmp_path / "run")  # not the stage it was in
+    assert not list(tmp_path.glob(".run.partial-*"))  # the stage is gone
 
 
 # ---------------------------------------------------------------- shipped models and long runs

@@ -171,20 +171,29 @@ def env_kwargs(text: str) -> dict[str, Any]:
     return value
 
 
+def _move_files(stage: Path, out: Path, folder: str = "") -> None:
+    for src in sorted(p for p in (stage / folder).rglob("*") if p.is_file()):
+        dest = out / src.relative_to(stage)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(src, dest)
+
+
 @contextlib.contextmanager
-def staged_output(out: Path) -> Iterator[Path]:
+def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[Path]:
     """A temporary folder next to ``out`` to write into; on success its files replace those
     of the same name under ``out`` (others there are kept), on any failure or interrupt it is
-    removed and ``out`` is left as it was."""
+    removed and ``out`` is left as it was, except for the subfolders ``keep_on_failure``
+    (e.g. a training run's checkpoints, new files that replace nothing whole)."""
     out = Path(out)
     out.absolute().parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.absolute().parent))
     try:
         yield stage
-        for src in sorted(p for p in stage.rglob("*") if p.is_file()):
-            dest = out / src.relative_to(stage)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(src, dest)
+        _move_files(stage, out)
+    except BaseException:
+        for folder in keep_on_failure:
+            _move_files(stage, out, folder)
+        raise
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 
