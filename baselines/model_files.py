@@ -297,7 +297,8 @@ def load_sb3_model(
     file = Path(path)
     name = str(path)
     if not file.is_file():
-        raise ValueError(f"policy: model file {name!r} does not exist")
+        raise ValueError(f"policy: model file {name!r} "
+                         f"{'is a folder' if file.is_dir() else 'does not exist'}")  # fmt: skip
     blob = file.read_bytes()  # read once: what is checked is what loads
     data, _ = read_model_data(blob, name)
     try:

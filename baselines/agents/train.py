@@ -20,7 +20,7 @@ import numpy as np
 
 from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
-from sgc_env import check_env_id
+from baselines.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
@@ -97,7 +97,7 @@ def _action_noise(hp, action_space: gym.spaces.Box):
 
 def _validate(cfg: TrainConfig) -> None:
     algorithm_class(cfg.algo)
-    check_env_id(cfg.env_id, "env")
+    check_env_kwargs(cfg.env_id, cfg.env_kwargs, "env_kwargs")
     if cfg.init not in ("none", "bc"):
         raise ValueError(f"init: expected 'none' or 'bc', got {cfg.init!r}")
     if cfg.init == "bc":
@@ -169,9 +169,12 @@ def train(cfg: TrainConfig) -> TrainResult:
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         kwargs["tensorboard_log"] = str(out / "tb")
-    model = algorithm_class(cfg.algo)(
-        hp.policy, env, seed=cfg.seed, device=cfg.device, verbose=cfg.verbose, **kwargs
-    )
+    try:
+        model = algorithm_class(cfg.algo)(
+            hp.policy, env, seed=cfg.seed, device=cfg.device, verbose=cfg.verbose, **kwargs
+        )
+    except (TypeError, ValueError, AssertionError) as exc:  # values SB3 itself refuses
+        raise ValueError(f"hyperparameters of {cfg.algo} for {cfg.env_id}: {exc}") from None
     bc_info = None
     if cfg.init == "bc":
         bc_info = _clone(model, cfg)
