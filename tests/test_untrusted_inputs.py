@@ -115,3 +115,29 @@ def test_bad_policy_specs_exit_2(
     if command == "evaluate":
         argv += ["--episodes", "1"]
     assert SPECS[spec] in _error(argv, capsys)
+
+
+def test_demonstrations_with_a_pickled_array_are_refused(tmp_path: Path) -> None:
+    import numpy as np
+
+    from baselines.agents.demos import load_demos
+
+    marker = tmp_path / "pwned"
+    path = tmp_path / "d.npz"
+    np.savez(path, observations=np.array([_Payload(marker)], dtype=object), format_version=1)
+    with pytest.raises(ValueError, match="not a demonstrations file"):
+        load_demos(path)
+    assert not marker.exists()
+    path.write_bytes(b"PK\x03\x04 truncated")
+    with pytest.raises(ValueError, match=f"demos: {path} is not a demonstrations file"):
+        load_demos(path)
+
+
+class _Payload:
+    def __init__(self, marker: Path) -> None:
+        self.marker = marker
+
+    def __reduce__(self) -> tuple:
+        import os
+
+        return (os.system, (f"touch '{self.marker}'",))

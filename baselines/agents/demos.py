@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import io
 import json
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -99,10 +100,21 @@ class Demonstrations:
 
 
 def load_demos(path: str | Path) -> Demonstrations:
-    """Read a file written by :meth:`Demonstrations.save`."""
+    """Read a file written by :meth:`Demonstrations.save` (never unpickling: a malformed or
+    hostile file is a ValueError naming it)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"demos: no such file {path}")
+    try:
+        return _read_demos(path)
+    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        if str(exc).startswith("demos:"):
+            raise
+        raise ValueError(f"demos: {path} is not a demonstrations file from `sgc demos` "
+                         f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+
+
+def _read_demos(path: Path) -> Demonstrations:
     with np.load(path, allow_pickle=False) as data:
         version = int(data["format_version"]) if "format_version" in data else None
         if version != FORMAT_VERSION:
