@@ -260,11 +260,17 @@ def _trained_on(path: str) -> str:
     return ""
 
 
-def safe_custom_objects(data: dict[str, Any], env: Any, path: str) -> dict[str, Any]:
+def safe_custom_objects(
+    data: dict[str, Any], env: Any, path: str, algorithm: type
+) -> dict[str, Any]:
     """A replacement for every pickled field of ``data`` (:class:`ModelFileError` when one
-    cannot be rebuilt without unpickling)."""
+    cannot be rebuilt without unpickling, or when a field would shadow one of
+    ``algorithm``'s methods: SB3 sets every field as an attribute of the model)."""
     objects: dict[str, Any] = {}
     for key, entry in data.items():
+        if key.startswith("__") or callable(getattr(algorithm, key, None)):
+            raise _fail(path, f"field {key!r} is not a model attribute (it would replace "
+                              f"{algorithm.__name__}.{key})")  # fmt: skip
         if key in ("observation_space", "action_space"):
             objects[key] = _space_field(entry, key, getattr(env, key), path)
         elif not _pickled(entry):
@@ -311,7 +317,7 @@ def load_sb3_model(
     elif env is None:
         raise _fail(name, "safe loading rebuilds the spaces from the env: pass env")
     else:
-        objects = safe_custom_objects(data, env, name)
+        objects = safe_custom_objects(data, env, name, algorithm)
     try:
         return algorithm.load(io.BytesIO(blob), env=env, device=device, custom_objects=objects)
     except pickle.UnpicklingError as exc:

@@ -166,6 +166,13 @@ def _foreign_class(clean: Path, tmp: Path) -> Path:
     return _rewrite(clean, tmp / "bad.zip", data=json.dumps(data).encode())
 
 
+def _shadowing_field(clean: Path, tmp: Path) -> Path:
+    with zipfile.ZipFile(clean) as archive:
+        data = json.loads(archive.read("data"))
+    data["predict"] = "not a method"
+    return _rewrite(clean, tmp / "bad.zip", data=json.dumps(data).encode())
+
+
 def _other_env(clean: Path, tmp: Path) -> Path:
     return SHIPPED / "ppo_dagger_SGCRod-v0.zip"  # trained on the rod: 6 actions, not 3
 
@@ -187,6 +194,7 @@ MALFORMED = {
     "no weights": (_no_weights, "missing member(s) ['policy.pth']"),
     "data not json": (_not_json, "member 'data' is not JSON"),
     "class off the allow-list": (_foreign_class, "'subprocess.Popen', which is not on the"),
+    "field shadowing a method": (_shadowing_field, "would replace PPO.predict"),
     "other env's spaces": (_other_env, "action space Box(shape=(6,), float32) does not fit"),
     "statistics of another shape": (_wrong_statistics, "do not fit the env's observations"),
 }

@@ -3,7 +3,10 @@
 Writes ``OUT/runs/<env>/<recipe>/seed<N>/`` per run (``config.json``, ``command.txt``, the
 models, ``result.json``) and ``OUT/leaderboard.{md,json}`` plus one PNG per env
 (performance profile and learning curves). Rerunning the same command skips finished runs
-(and failed ones unless ``--retry-failed``). See docs/agents.md.
+(and failed ones unless ``--retry-failed``); a run is finished once its ``result.json`` is
+written, so a benchmark killed mid-grid (even by SIGKILL) resumes where it was. Two
+benchmarks on one ``--out`` share the work: each run is claimed by one of them
+(:mod:`baselines.benchmark.claims`) and every file is written atomically. See docs/agents.md.
 """
 
 from __future__ import annotations
