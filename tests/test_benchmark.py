@@ -117,12 +117,13 @@ def test_learning_curve_uses_steps_every_run_has() -> None:
 
 
 def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
-    (spec,) = build_grid(recipes_from_algos(["ppo"], str(tiny_hp), {"a": 1}, 64), ["SGCPoint-v0"],
-                         [3], eval_freq=64, curve_episodes=1, eval_episodes=2)  # fmt: skip
+    recipes = recipes_from_algos(["ppo"], str(tiny_hp), {"reward": "distance"}, 64)
+    (spec,) = build_grid(recipes, ["SGCPoint-v0"], [3], eval_freq=64, curve_episodes=1,
+                         eval_episodes=2)  # fmt: skip
     command = train_command(spec.train_options(out="DIR"))
     assert command == (f"sgc train --algo ppo --env SGCPoint-v0 --seed 3 --timesteps 64 "
                        f"--out DIR --eval-freq 64 --eval-episodes 1 --hyperparams {tiny_hp} "
-                       "--env-kwargs '{\"a\": 1}'")  # fmt: skip
+                       "--env-kwargs '{\"reward\": \"distance\"}'")  # fmt: skip
 
 
 @pytest.mark.parametrize(
@@ -135,6 +136,7 @@ def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
         ({"test_seed": 10_001}, "overlap"),
         ({"recipes": [Recipe("a", "ppo"), Recipe("a", "sac")]}, "more than once"),
         ({"recipes": []}, "give --algo or --recipes"),
+        ({"recipes": [Recipe("a", "ppo", env_kwargs={"a": 1})]}, "does not take {'a': 1}"),
     ],
 )
 def test_bad_grid_arguments_are_named(kwargs: dict, message: str) -> None:
