@@ -5,18 +5,19 @@ Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tan
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
 :mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
-then). A model trained behind ``VecNormalize``
-gets the statistics ``sgc train`` saved beside it (:func:`vecnormalize_path`), so it sees the
-observations it was trained on. Every policy has the SB3 signature
+then). Model files are loaded without unpickling anything (:mod:`baselines.model_files`)
+unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model trained
+behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
+(:func:`vecnormalize_path`, :mod:`baselines.normalization`), so it sees the observations it
+was trained on. Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
 
 from __future__ import annotations
 
-import importlib
-import pickle
-import re
-from collections.abc import Sequence
+import contextlib
+import contextvars
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
@@ -31,6 +32,8 @@ from baselines.comparison_policies import (
     predict_per_env,
 )
 from baselines.expert import SGCExpert
+from baselines.model_files import algorithm_from_data, load_sb3_model
+from baselines.normalization import load_statistics, statistics_path
 from baselines.shipped import resolve_policy_spec
 
 __all__ = [
@@ -44,13 +47,14 @@ __all__ = [
     "make_policy",
     "policy_label",
     "policy_labels",
+    "trusted_models",
     "vecnormalize_path",
 ]
 
 BUILTIN_POLICIES: tuple[str, ...] = (
     "expert", "expert-paper", "dynamic-constraints", "minimum-jerk", "random"
 )  # fmt: skip
-SB3_ALGORITHMS: tuple[str, ...] = ("PPO", "SAC", "TD3", "A2C", "DDPG")
+_TRUST_MODELS: contextvars.ContextVar[bool] = contextvars.ContextVar("trust_models", default=False)
 
 
 @runtime_checkable
@@ -179,79 +183,25 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 
 
 def vecnormalize_path(model_path: str | Path) -> Path | None:
-    """The ``VecNormalize`` statistics saved with a model by ``sgc train``, if there are any.
-
-    ``<stem>.zip`` pairs with ``<stem>.vecnormalize.pkl`` beside it (shipped models) or else
-    ``vecnormalize.pkl`` in the same folder (``final_model.zip``/``best_model.zip``); a
-    checkpoint ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.pkl``
-    (SB3's ``CheckpointCallback`` names).
-    """
-    path = Path(model_path)
-    checkpoint = re.fullmatch(r"(.*)_(\d+)_steps", path.stem)
-    own = path.with_name(f"{path.stem}.vecnormalize.pkl")
-    if own.is_file():
-        return own
-    if checkpoint:
-        stats = path.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps.pkl")
-    else:
-        stats = path.with_name("vecnormalize.pkl")
-    return stats if stats.is_file() else None
+    """The ``VecNormalize`` statistics saved with a model (see :mod:`baselines.normalization`)."""
+    return statistics_path(model_path)
 
 
-def _with_saved_normalization(model: Any, path: str | Path) -> Any:
-    stats = vecnormalize_path(path)
+@contextlib.contextmanager
+def trusted_models(trust: bool = True) -> Iterator[None]:
+    """Within the block, model files load with SB3's unpickling (``--trust-model``)."""
+    token = _TRUST_MODELS.set(trust)
+    try:
+        yield
+    finally:
+        _TRUST_MODELS.reset(token)
+
+
+def _with_saved_normalization(model: Any, path: str | Path, env: Any, trust: bool) -> Any:
+    stats = statistics_path(path)
     if stats is None:
         return model
-    with stats.open("rb") as fh:
-        vec_normalize = pickle.load(fh)  # what VecNormalize.load does, without a venv
-    vec_normalize.training = False
-    return NormalizedPolicy(model, vec_normalize)
-
-
-def algorithm_from_data(data: dict[str, Any]) -> str:
-    """SB3 algorithm name of a saved model, from the data dict of its zip.
-
-    The policy class's module tells SAC (``sac.policies``) and TD3/DDPG (``td3.policies``)
-    apart from on-policy models (``common.policies``); DDPG is TD3 with ``policy_delay`` 1
-    and no target noise clip, PPO has a ``clip_range`` that A2C lacks.
-    """
-    policy_class = data.get("policy_class")
-    if policy_class is None:
-        raise ValueError("model data has no policy_class: not a Stable-Baselines3 model")
-    module = getattr(policy_class, "__module__", None)
-    if module is None and isinstance(policy_class, dict):
-        module = policy_class.get("__module__", "")
-    module = str(module)
-    if ".sac." in module:
-        return "SAC"
-    if ".td3." in module:
-        ddpg = data.get("policy_delay") == 1 and data.get("target_noise_clip") == 0.0
-        return "DDPG" if ddpg else "TD3"
-    if ".ppo." in module or "clip_range" in data:
-        return "PPO"
-    if ".a2c." in module or ".common." in module:
-        return "A2C"
-    raise ValueError(f"cannot tell the algorithm of a model with policy class from {module!r}")
-
-
-def load_sb3_model(path: str | Path, env: Any | None = None, device: str = "cpu") -> Any:
-    """Load a Stable-Baselines3 model zip, detecting its algorithm.
-
-    ``env`` is passed through to SB3: a HER model (a ``HerReplayBuffer`` in its data) cannot be
-    loaded without the env that computes its rewards, and for the others SB3 checks that the
-    model's spaces match the env's.
-    """
-    file = Path(path)
-    if not file.is_file():
-        raise ValueError(f"policy: model file {str(path)!r} does not exist")
-    from stable_baselines3.common.save_util import load_from_zip_file
-
-    data, _, _ = load_from_zip_file(file, load_data=True, device=device)
-    if data is None:
-        raise ValueError(f"policy: {str(path)!r} holds no model data")
-    name = algorithm_from_data(data)
-    algorithm = getattr(importlib.import_module("stable_baselines3"), name)
-    return algorithm.load(file, env=env, device=device)
+    return NormalizedPolicy(model, load_statistics(stats, env, trust_model=trust))
 
 
 def _needs_flat_observation(env: Any, spec: str) -> None:
@@ -262,8 +212,14 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
         )
 
 
-def make_policy(spec: str, env: Any, seed: int | None = None) -> Policy:
-    """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``."""
+def make_policy(
+    spec: str, env: Any, seed: int | None = None, trust_model: bool | None = None
+) -> Policy:
+    """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``.
+
+    ``trust_model``: unpickle model files (None: as :func:`trusted_models` says, by default
+    not; see :mod:`baselines.model_files`).
+    """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
     spec = resolve_policy_spec(spec)
@@ -279,7 +235,9 @@ def make_policy(spec: str, env: Any, seed: int | None = None) -> Policy:
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
-        return _with_saved_normalization(load_sb3_model(spec, env=env), spec)
+        trust = _TRUST_MODELS.get() if trust_model is None else trust_model
+        model = load_sb3_model(spec, env=env, trust_model=trust)
+        return _with_saved_normalization(model, spec, env, trust)
     raise ValueError(
         f"policy: unknown spec {spec!r}; expected one of {list(BUILTIN_POLICIES)} or the path "
         "of a Stable-Baselines3 model .zip"

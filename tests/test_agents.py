@@ -332,9 +332,11 @@ def test_behaviour_cloning_reduces_imitation_loss(tmp_path: Path, tiny_hp: Path)
     assert result.bc["loss_after"] < 0.5 * result.bc["loss_before"]
     assert result.bc["samples_after_dagger"] > len(demos)
     assert imitation_loss(result.model, demos) < result.bc["loss_before"]
+    import gymnasium as gym
+
     from baselines.policies import load_sb3_model
 
-    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip")
+    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip", env=gym.make("SGCPoint-v0"))
     obs = demos.observations[:5]
     np.testing.assert_allclose(
         reloaded.predict(obs, deterministic=True)[0],
@@ -371,6 +373,9 @@ def test_train_command_runs(tmp_path: Path, tiny_hp: Path) -> None:
     )  # fmt: skip
     assert train_command.run(args) == 0
     assert (tmp_path / "run" / "final_model.zip").is_file()
+    config = json.loads((tmp_path / "run" / "config.json").read_text())
+    assert config["train_config"]["out"] == str(tmp_path / "run")  # not the stage it was in
+    assert not list(tmp_path.glob(".run.partial-*"))  # the stage is gone
 
 
 # ---------------------------------------------------------------- shipped models and long runs
@@ -531,5 +536,5 @@ def test_normalize_saves_statistics_and_evaluates_on_raw_observations(tmp_path: 
             out=out,
         )  # fmt: skip
     )
-    assert (out / "vecnormalize.pkl").is_file() and (out / "best_model.zip").is_file()
+    assert (out / "vecnormalize.json").is_file() and (out / "best_model.zip").is_file()
     assert result.evaluations and result.evaluations[-1]["n_goals"] >= 1

@@ -3,6 +3,11 @@
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -112,12 +117,13 @@ def test_learning_curve_uses_steps_every_run_has() -> None:
 
 
 def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
-    (spec,) = build_grid(recipes_from_algos(["ppo"], str(tiny_hp), {"a": 1}, 64), ["SGCPoint-v0"],
-                         [3], eval_freq=64, curve_episodes=1, eval_episodes=2)  # fmt: skip
+    recipes = recipes_from_algos(["ppo"], str(tiny_hp), {"reward": "distance"}, 64)
+    (spec,) = build_grid(recipes, ["SGCPoint-v0"], [3], eval_freq=64, curve_episodes=1,
+                         eval_episodes=2)  # fmt: skip
     command = train_command(spec.train_options(out="DIR"))
     assert command == (f"sgc train --algo ppo --env SGCPoint-v0 --seed 3 --timesteps 64 "
                        f"--out DIR --eval-freq 64 --eval-episodes 1 --hyperparams {tiny_hp} "
-                       "--env-kwargs '{\"a\": 1}'")  # fmt: skip
+                       "--env-kwargs '{\"reward\": \"distance\"}'")  # fmt: skip
 
 
 @pytest.mark.parametrize(
@@ -130,6 +136,7 @@ def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
         ({"test_seed": 10_001}, "overlap"),
         ({"recipes": [Recipe("a", "ppo"), Recipe("a", "sac")]}, "more than once"),
         ({"recipes": []}, "give --algo or --recipes"),
+        ({"recipes": [Recipe("a", "ppo", env_kwargs={"a": 1})]}, "does not take {'a': 1}"),
     ],
 )
 def test_bad_grid_arguments_are_named(kwargs: dict, message: str) -> None:
@@ -276,3 +283,69 @@ def test_failed_runs_are_recorded_and_retried_on_request(
     assert "1 to run" in capsys.readouterr().out
     board = json.loads((tmp_path / "b" / "leaderboard.json").read_text())
     assert board["rows"][0]["failed_seeds"] == [0] and board["rows"][0]["seeds"] == []
+
+
+# ---------------------------------------------------------------- killed and concurrent drivers
+# Real processes on the tiny grid (one worker), so that SIGKILL and two drivers racing for one
+# folder are what happens, not a simulation of it.
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _process_argv(out: Path, hp: Path) -> list[str]:
+    """The tiny grid with one worker, as its own process."""
+    return [sys.executable, "-m", "baselines.cli.main", *_tiny_argv(out, hp, "--workers", "1")]
+
+
+def _start(out: Path, hp: Path) -> subprocess.Popen:
+    path = os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])
+    return subprocess.Popen(_process_argv(out, hp), env={**os.environ, "PYTHONPATH": path},
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)  # fmt: skip
+
+
+def _run(out: Path, seed: int) -> Path:
+    return out / "runs" / "SGCPoint-v0" / "ppo" / f"seed{seed}"
+
+
+def test_sigkill_mid_grid_resumes_without_retraining_the_finished_run(
+    tmp_path: Path, tiny_hp: Path, capsys: pytest.CaptureFixture
+) -> None:
+    out = tmp_path / "bench"
+    first = _run(out, 0) / "result.json"
+    proc = _start(out, tiny_hp)
+    deadline = time.monotonic() + 240
+    while not first.is_file() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)  # the driver and anything it started
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL, proc.stdout.read() if proc.stdout else ""
+    assert first.is_file() and not (_run(out, 1) / "result.json").exists()
+    before = (first.read_bytes(), first.stat().st_mtime_ns)
+    json.loads(before[0])  # whole, not half written
+    assert cli.main(_process_argv(out, tiny_hp)[3:]) == 0  # the same command, in this process
+    again = capsys.readouterr().out
+    assert "2 runs: 1 finished before" in again and "1 to run" in again
+    assert "seed0: finished" not in again and "seed1: finished" in again
+    assert (first.read_bytes(), first.stat().st_mtime_ns) == before  # not retrained
+    rows = json.loads((out / "leaderboard.json").read_text())["rows"]
+    assert rows[0]["seeds"] == [0, 1]
+
+
+def test_two_benchmarks_on_one_out_train_each_run_once_and_leave_it_whole(
+    tmp_path: Path, tiny_hp: Path
+) -> None:
+    out = tmp_path / "bench"
+    procs = [_start(out, tiny_hp), _start(out, tiny_hp)]
+    logs = [p.communicate(timeout=300)[0] for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], logs
+    trained = [line for log in logs for line in log.splitlines() if ": finished in" in line]
+    assert sorted(line.split(":")[0] for line in trained) == [
+        "SGCPoint-v0/ppo/seed0", "SGCPoint-v0/ppo/seed1",
+    ], logs  # fmt: skip
+    for seed in (0, 1):
+        record = json.loads((_run(out, seed) / "result.json").read_text())
+        assert record["status"] == "finished" and record["spec"]["seed"] == seed
+    assert not list(out.rglob("*.tmp")), "a temporary file was left behind"
+    board = json.loads((out / "leaderboard.json").read_text())  # the last to finish wrote it
+    assert board["rows"][0]["seeds"] == [0, 1] and board["meta"]["finished"] == 2

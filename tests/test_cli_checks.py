@@ -131,3 +131,45 @@ def test_interrupted_demo_leaves_no_stub_video_beside_old_plates(tmp_path, monke
     assert (out / "three_rods.mp4").read_bytes() == b"earlier, whole video"
     assert (out / "plates.png").read_bytes() == b"earlier plates"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["demo"]
+
+
+def test_interrupted_train_keeps_the_earlier_run_and_the_new_checkpoints(tmp_path, monkeypatch):
+    import baselines.agents.train as train_module
+
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "final_model.zip").write_bytes(b"the earlier, whole model")
+    (out / "config.json").write_text('{"earlier": true}')
+
+    def interrupted(cfg):
+        (Path(cfg.out) / "checkpoints").mkdir()
+        (Path(cfg.out) / "checkpoints" / "ppo_64_steps.zip").write_bytes(b"checkpoint")
+        (Path(cfg.out) / "final_model.zip").write_bytes(b"half a model")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(train_module, "train", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli.main([*TRAIN, "--out", str(out)])
+    assert (out / "final_model.zip").read_bytes() == b"the earlier, whole model"
+    assert json.loads((out / "config.json").read_text()) == {"earlier": True}
+    assert (out / "checkpoints" / "ppo_64_steps.zip").read_bytes() == b"checkpoint"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run"]
+
+
+def test_interrupted_demos_save_keeps_the_earlier_file(tmp_path, monkeypatch):
+    import baselines.atomic_files as atomic
+
+    out = tmp_path / "d.npz"
+    out.write_bytes(b"the earlier, whole demos")
+
+    def interrupted(fd):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(atomic.os, "fsync", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        cli.main([*DEMOS, "--out", str(out)])
+    assert out.read_bytes() == b"the earlier, whole demos"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.npz"]
+    monkeypatch.undo()
+    assert cli.main([*DEMOS, "--out", str(out)]) == 0
+    assert out.read_bytes()[:2] == b"PK" and sorted(p.name for p in tmp_path.iterdir()) == ["d.npz"]

@@ -26,7 +26,7 @@ ENTRIES = load_manifest()
 def test_manifest_lists_exactly_the_shipped_models() -> None:
     assert ENTRIES, "baselines/checkpoints/manifest.json is missing or empty"
     assert check_manifest() == []
-    shipped = [p for p in CHECKPOINTS.iterdir() if p.suffix in (".zip", ".pkl")]
+    shipped = [p for p in CHECKPOINTS.iterdir() if p.suffix in (".zip", ".json")]
     assert sum(p.stat().st_size for p in shipped) < 20 * 1024 * 1024
 
 
@@ -93,7 +93,7 @@ def test_shipped_model_carries_its_normalisation(tmp_path: Path) -> None:
     folder = tmp_path / "ship"
     folder.mkdir()
     entry = ship_model(run, "tiny", which="final", episodes=1, seed=20_000, folder=folder)
-    assert (folder / "tiny.vecnormalize.pkl").is_file() and check_manifest(folder) == []
+    assert (folder / "tiny.vecnormalize.json").is_file() and check_manifest(folder) == []
     assert entry["demonstrations"] is False and entry["timesteps"] == 128
     alone = folder / "alone"
     alone.mkdir()

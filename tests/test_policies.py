@@ -165,13 +165,15 @@ def test_policy_labels_are_distinct():
 @pytest.mark.parametrize(
     ("model", "stats"),
     [
-        ("final_model.zip", "vecnormalize.pkl"),
-        ("ppo_2048_steps.zip", "ppo_vecnormalize_2048_steps.pkl"),
+        ("final_model.zip", "vecnormalize.json"),
+        ("ppo_2048_steps.zip", "ppo_vecnormalize_2048_steps.json"),
     ],
 )
 def test_models_trained_behind_vecnormalize_get_their_statistics(tmp_path, model, stats):
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    from baselines.normalization import save_statistics
 
     env = gym.make("SGCPoint-v0")
     ppo = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")
@@ -181,7 +183,7 @@ def test_models_trained_behind_vecnormalize_get_their_statistics(tmp_path, model
     normalizer = VecNormalize(DummyVecEnv([lambda: gym.make("SGCPoint-v0")]), norm_reward=False)
     normalizer.obs_rms.mean[:] = 3.0
     normalizer.obs_rms.var[:] = 4.0
-    normalizer.save(str(tmp_path / stats))
+    save_statistics(normalizer, tmp_path / stats)
     policy = make_policy(str(tmp_path / model), env)
     assert vecnormalize_path(tmp_path / model) == tmp_path / stats
     assert isinstance(policy, NormalizedPolicy) and not policy.vec_normalize.training

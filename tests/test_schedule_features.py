@@ -4,7 +4,6 @@ goals, and that a model trained on them evaluates from its file alone."""
 from __future__ import annotations
 
 import json
-import pickle
 from pathlib import Path
 
 import gymnasium as gym
@@ -144,9 +143,8 @@ def test_model_on_the_features_evaluates_from_its_file_alone(tmp_path: Path) -> 
     )
     out = tmp_path / "run"
     train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", hyperparams_dir=tmp_path, out=out))
-    with open(out / "vecnormalize.pkl", "rb") as fh:
-        assert pickle.load(fh).norm_obs is False
-    model = load_sb3_model(out / "final_model.zip")
+    assert json.loads((out / "vecnormalize.json").read_text())["norm_obs"] is False
+    model = load_sb3_model(out / "final_model.zip", env=gym.make("SGCPoint-v0"))
     assert isinstance(model.policy.features_extractor, ScheduleFeatures)
     config = json.loads((out / "config.json").read_text())
     assert "ScheduleFeatures" in config["hyperparams"]["policy_kwargs"]

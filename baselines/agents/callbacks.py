@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback
 
+from baselines.normalization import save_statistics
 from baselines.policies import NormalizedPolicy
 from sgc_env.defaults import EVAL_SEED
 
@@ -24,6 +25,7 @@ __all__ = [
     "EVAL_SEED",
     "FreezeActorCallback",
     "HarnessEvalCallback",
+    "StatisticsCheckpointCallback",
     "score_key",
 ]
 
@@ -108,7 +110,7 @@ class HarnessEvalCallback(BaseCallback):
                 self.best_model_dir.mkdir(parents=True, exist_ok=True)
                 self.model.save(self.best_model_dir / "best_model")
                 if self.vec_normalize is not None:
-                    self.vec_normalize.save(str(self.best_model_dir / "vecnormalize.pkl"))
+                    save_statistics(self.vec_normalize, self.best_model_dir / "vecnormalize.json")
         if self.best_model_dir is not None:
             (self.best_model_dir / "evaluations.json").write_text(
                 json.dumps(self.history, indent=1)
@@ -159,3 +161,20 @@ class FreezeActorCallback(BaseCallback):
 
     def _on_step(self) -> bool:
         return True
+
+
+class StatisticsCheckpointCallback(CheckpointCallback):
+    """SB3's ``CheckpointCallback`` with the ``VecNormalize`` statistics in JSON
+    (``<prefix>_vecnormalize_<N>_steps.json``, :mod:`baselines.normalization`), not a pickle."""
+
+    def __init__(self, save_freq: int, save_path: str, name_prefix: str = "rl_model",
+                 save_vecnormalize: bool = False) -> None:  # fmt: skip
+        super().__init__(save_freq, save_path, name_prefix=name_prefix)
+        self.save_statistics = save_vecnormalize
+
+    def _on_step(self) -> bool:
+        keep_going = super()._on_step()
+        stats = self.model.get_vec_normalize_env()
+        if self.save_statistics and stats is not None and self.n_calls % self.save_freq == 0:
+            save_statistics(stats, self._checkpoint_path("vecnormalize_", extension="json"))
+        return keep_going

@@ -22,7 +22,9 @@ Files written before ``pushes`` existed load with the default (no pushes).
 
 from __future__ import annotations
 
+import io
 import json
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,6 +33,7 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.agents.pushes import Pushes, apply_random_push, push_rng
+from baselines.atomic_files import write_atomic
 from sgc_env import check_env_id
 
 __all__ = ["FORMAT_VERSION", "Demonstrations", "load_demos", "record_demos"]
@@ -61,24 +64,23 @@ class Demonstrations:
         return int(self.episode_starts.sum())
 
     def save(self, path: str | Path) -> Path:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with path.open("wb") as fh:
-            np.savez_compressed(
-                fh,
-                observations=self.observations,
-                actions=self.actions,
-                rewards=self.rewards,
-                terminations=self.terminations,
-                truncations=self.truncations,
-                episode_starts=self.episode_starts,
-                seeds=self.seeds,
-                env_id=np.array(self.env_id),
-                env_kwargs=np.array(json.dumps(self.env_kwargs, sort_keys=True)),
-                pushes=np.array(json.dumps(self.pushes.to_dict(), sort_keys=True)),
-                format_version=np.array(FORMAT_VERSION),
-            )
-        return path
+        """Write the npz at ``path`` atomically (an interrupted save leaves the old file)."""
+        fh = io.BytesIO()
+        np.savez_compressed(
+            fh,
+            observations=self.observations,
+            actions=self.actions,
+            rewards=self.rewards,
+            terminations=self.terminations,
+            truncations=self.truncations,
+            episode_starts=self.episode_starts,
+            seeds=self.seeds,
+            env_id=np.array(self.env_id),
+            env_kwargs=np.array(json.dumps(self.env_kwargs, sort_keys=True)),
+            pushes=np.array(json.dumps(self.pushes.to_dict(), sort_keys=True)),
+            format_version=np.array(FORMAT_VERSION),
+        )
+        return write_atomic(path, fh.getvalue())
 
     def extend(self, observations: np.ndarray, actions: np.ndarray) -> Demonstrations:
         """A copy with relabelled states appended (DAgger); step fields are zero-filled."""
@@ -98,10 +100,21 @@ class Demonstrations:
 
 
 def load_demos(path: str | Path) -> Demonstrations:
-    """Read a file written by :meth:`Demonstrations.save`."""
+    """Read a file written by :meth:`Demonstrations.save` (never unpickling: a malformed or
+    hostile file is a ValueError naming it)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"demos: no such file {path}")
+    try:
+        return _read_demos(path)
+    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        if str(exc).startswith("demos:"):
+            raise
+        raise ValueError(f"demos: {path} is not a demonstrations file from `sgc demos` "
+                         f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+
+
+def _read_demos(path: Path) -> Demonstrations:
     with np.load(path, allow_pickle=False) as data:
         version = int(data["format_version"]) if "format_version" in data else None
         if version != FORMAT_VERSION:

@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from baselines.shipped import hyperparams_file
+from baselines.value_types import describe, matches
 
 __all__ = [
     "ALGORITHMS",
@@ -130,16 +131,14 @@ def linear_schedule(initial: float):
 
 
 def _learning_rate(value: Any) -> Any:
-    if isinstance(value, str):
-        if value.startswith("lin_"):
+    try:
+        if isinstance(value, str) and value.startswith("lin_"):
             return linear_schedule(float(value[4:]))
-        try:
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
             return float(value)
-        except ValueError as exc:
-            raise ValueError(
-                f"learning_rate: expected a number or lin_<number>, got {value!r}"
-            ) from exc
-    return float(value)
+    except ValueError:
+        pass
+    raise ValueError(f"learning_rate: expected a number or lin_<number>, got {value!r}")
 
 
 _NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward")
@@ -156,6 +155,10 @@ def _normalize(value: Any, where: str) -> tuple[bool, dict[str, Any]]:
     unknown = sorted(set(value) - set(_NORMALIZE_KEYS))
     if unknown:
         raise ValueError(f"{where}: normalize: unknown keys {unknown} (known: {_NORMALIZE_KEYS})")
+    for key, item in value.items():
+        kind = bool if key.startswith("norm_") else float
+        if not matches(item, kind):
+            raise ValueError(f"{where}: normalize: {key} must be {describe(kind)}, got {item!r}")
     return True, dict(value)
 
 
@@ -181,7 +184,7 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
     try:
         table = yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:
-        raise ValueError(f"{path}: bad YAML: {exc}") from exc
+        raise ValueError(f"{path}: bad YAML: {' '.join(str(exc).split())}") from None
     if not isinstance(table, dict):
         raise ValueError(f"{path}: expected a mapping of env id -> hyperparameters")
     if env_id not in table:
@@ -193,7 +196,8 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         if key not in entry:
             raise ValueError(f"{path}: {env_id}: missing field {key!r}")
     kwargs: dict[str, Any] = {}
-    allowed = set(inspect.signature(algo_cls.__init__).parameters) - {"self", "policy", "env"}
+    parameters = inspect.signature(algo_cls.__init__).parameters
+    allowed = set(parameters) - {"self", "policy", "env"}
     for key, value in entry.items():
         if key in _ZOO_KEYS:
             continue
@@ -202,9 +206,15 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         if key in _STRING_KWARGS and isinstance(value, str):
             value = parse_kwargs_string(value, key)
         elif key == "learning_rate":
-            value = _learning_rate(value)
+            try:
+                value = _learning_rate(value)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {env_id}: {exc}") from None
         elif key == "replay_buffer_class" and isinstance(value, str):
             value = _resolve_name(value, key)
+        if matches(value, parameters[key].annotation) is False:
+            hint = describe(parameters[key].annotation)
+            raise ValueError(f"{path}: {env_id}: {key} must be {hint}, got {value!r}")
         kwargs[key] = value
     normalize, normalize_kwargs = _normalize(entry.get("normalize", False), f"{path}: {env_id}")
     noise_type = entry.get("noise_type")
@@ -213,8 +223,12 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
     try:
         n_timesteps = int(float(entry["n_timesteps"]))
         n_envs = int(entry.get("n_envs", 1))
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{path}: {env_id}: n_timesteps and n_envs must be numbers") from exc
+        noise_std = float(entry.get("noise_std", 0.1))
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs and noise_std must be finite "
+                         "numbers") from None  # fmt: skip
+    if not isinstance(entry["policy"], str):
+        raise ValueError(f"{path}: {env_id}: policy must be a name such as MlpPolicy")
     if n_envs < 1:
         raise ValueError(f"{path}: {env_id}: n_envs must be >= 1, got {n_envs}")
     return Hyperparams(
@@ -226,7 +240,7 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         normalize=normalize,
         normalize_kwargs=normalize_kwargs,
         noise_type=noise_type,
-        noise_std=float(entry.get("noise_std", 0.1)),
+        noise_std=noise_std,
         algo_kwargs=kwargs,
         raw=dict(entry),
     )

@@ -78,8 +78,8 @@ def record_minari(
     ``publisher``: Minari's ``author``, ``author_email``, ``code_permalink`` (Minari warns
     when they are missing).
     """
-    from baselines.agents.train import check_env_id
     from baselines.policies import make_policy
+    from sgc_env import check_env_id
 
     check_env_id(env_id)
     if episodes < 1:

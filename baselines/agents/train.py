@@ -20,7 +20,7 @@ import numpy as np
 
 from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
-from sgc_env import check_env_id
+from baselines.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
@@ -97,7 +97,7 @@ def _action_noise(hp, action_space: gym.spaces.Box):
 
 def _validate(cfg: TrainConfig) -> None:
     algorithm_class(cfg.algo)
-    check_env_id(cfg.env_id, "env")
+    check_env_kwargs(cfg.env_id, cfg.env_kwargs, "env_kwargs")
     if cfg.init not in ("none", "bc"):
         raise ValueError(f"init: expected 'none' or 'bc', got {cfg.init!r}")
     if cfg.init == "bc":
@@ -134,12 +134,17 @@ def _jsonable(value: Any) -> Any:
 def train(cfg: TrainConfig) -> TrainResult:
     """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
     import torch as th
-    from stable_baselines3.common.callbacks import BaseCallback, CallbackList, CheckpointCallback
+    from stable_baselines3.common.callbacks import BaseCallback, CallbackList
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from baselines.agents.callbacks import FreezeActorCallback, HarnessEvalCallback
+    from baselines.agents.callbacks import (
+        FreezeActorCallback,
+        HarnessEvalCallback,
+        StatisticsCheckpointCallback,
+    )
     from baselines.agents.hyperparams import load_hyperparams
+    from baselines.normalization import save_statistics
 
     _validate(cfg)
     started = time.perf_counter()
@@ -164,9 +169,12 @@ def train(cfg: TrainConfig) -> TrainResult:
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         kwargs["tensorboard_log"] = str(out / "tb")
-    model = algorithm_class(cfg.algo)(
-        hp.policy, env, seed=cfg.seed, device=cfg.device, verbose=cfg.verbose, **kwargs
-    )
+    try:
+        model = algorithm_class(cfg.algo)(
+            hp.policy, env, seed=cfg.seed, device=cfg.device, verbose=cfg.verbose, **kwargs
+        )
+    except (TypeError, ValueError, AssertionError) as exc:  # values SB3 itself refuses
+        raise ValueError(f"hyperparameters of {cfg.algo} for {cfg.env_id}: {exc}") from None
     bc_info = None
     if cfg.init == "bc":
         bc_info = _clone(model, cfg)
@@ -175,7 +183,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         callbacks.append(FreezeActorCallback(cfg.critic_warmup))
     if out is not None and cfg.checkpoint_freq:
         callbacks.append(
-            CheckpointCallback(
+            StatisticsCheckpointCallback(
                 max(cfg.checkpoint_freq // hp.n_envs, 1), str(out / "checkpoints"),
                 name_prefix=cfg.algo, save_vecnormalize=hp.normalize,
             )
@@ -231,7 +239,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     if out is not None:
         result.model_path = Path(model.save(out / "final_model") or out / "final_model.zip")
         if hp.normalize:
-            env.save(str(out / "vecnormalize.pkl"))
+            save_statistics(env, out / "vecnormalize.json")
         (out / "config.json").write_text(json.dumps(_jsonable(config), indent=1))
     env.close()
     return result
@@ -268,8 +276,11 @@ def _clone(model: Any, cfg: TrainConfig) -> dict[str, Any]:
     return info
 
 
-def load_model(path: str | Path, env: Any | None = None, device: str = "cpu") -> Any:
-    """Load an SB3 ``.zip`` whatever algorithm wrote it (with ``env``, HER models too)."""
-    from baselines.policies import load_sb3_model
+def load_model(
+    path: str | Path, env: Any | None = None, device: str = "cpu", trust_model: bool = False
+) -> Any:
+    """Load an SB3 ``.zip`` whatever algorithm wrote it, without unpickling unless
+    ``trust_model`` (:mod:`baselines.model_files`; safe loading needs ``env``)."""
+    from baselines.model_files import load_sb3_model
 
-    return load_sb3_model(path, env=env, device=device)
+    return load_sb3_model(path, env=env, device=device, trust_model=trust_model)

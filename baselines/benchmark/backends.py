@@ -20,6 +20,7 @@ __all__ = ["BACKENDS", "LocalBackend", "RayBackend", "make_backend"]
 BACKENDS: tuple[str, ...] = ("local", "ray")
 
 Started = Callable[[str], None]
+Claim = Callable[[dict[str, Any]], bool]
 
 
 def _throttled(
@@ -29,11 +30,13 @@ def _throttled(
     wait_some: Callable[[list[Any]], tuple[list[Any], list[Any]]],
     collect: Callable[[Any], dict[str, Any]],
     on_start: Started | None,
+    claim: Claim | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Keep at most ``capacity`` runs in flight (so "running" means running), yield outcomes.
 
     A run whose worker dies (killed, out of memory) comes back as a failed outcome, like a
-    run that raised, so that the grid goes on and records it.
+    run that raised, so that the grid goes on and records it. ``claim(spec)`` is asked just
+    before a run starts; a run it refuses (another process has it) is skipped.
     """
     queue = list(specs)
     owners: dict[int, dict[str, Any]] = {}
@@ -41,11 +44,15 @@ def _throttled(
     while queue or pending:
         while queue and len(pending) < capacity:
             spec = queue.pop(0)
+            if claim is not None and not claim(spec):
+                continue
             if on_start is not None:
                 on_start(spec["run_id"])
             handle = submit(spec)
             owners[id(handle)] = spec
             pending.append(handle)
+        if not pending:
+            break
         done, pending = wait_some(pending)
         for handle in done:
             spec = owners.pop(id(handle))
@@ -71,15 +78,16 @@ class LocalBackend:
         self.description = f"local process pool, {workers} worker(s)"
 
     def run(
-        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None
+        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None,
+        claim: Claim | None = None,
     ) -> Iterator[dict[str, Any]]:
-        """Yield each run's outcome as it finishes (``on_start(run_id)`` when one begins)."""
+        """Yield each run's outcome as it finishes (``on_start(run_id)`` when one begins,
+        ``claim(spec)`` just before: see :func:`_throttled`)."""
         if not specs:
             return
         if self.workers == 1:  # one at a time: in this process, no start-up cost
-            yield from _throttled(
-                specs, 1, execute_run, lambda pending: (pending, []), lambda out: out, on_start
-            )
+            yield from _throttled(specs, 1, execute_run, lambda pending: (pending, []),
+                                  lambda out: out, on_start, claim)  # fmt: skip
             return
         context = multiprocessing.get_context("spawn")  # no forked torch/PyBullet state
         with ProcessPoolExecutor(min(self.workers, len(specs)), mp_context=context) as pool:
@@ -90,7 +98,7 @@ class LocalBackend:
 
             yield from _throttled(
                 specs, self.workers, lambda spec: pool.submit(execute_run, spec), wait_some,
-                lambda future: future.result(), on_start,
+                lambda future: future.result(), on_start, claim,
             )  # fmt: skip
 
 
@@ -133,7 +141,8 @@ class RayBackend:
         return True
 
     def run(
-        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None
+        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None,
+        claim: Claim | None = None,
     ) -> Iterator[dict[str, Any]]:
         """Submit every run as a task and yield outcomes in the order they finish."""
         if not specs:
@@ -147,7 +156,8 @@ class RayBackend:
             def wait_some(pending: list[Any]) -> tuple[list[Any], list[Any]]:
                 return self.ray.wait(pending, num_returns=1)
 
-            yield from _throttled(specs, capacity, task.remote, wait_some, self.ray.get, on_start)
+            yield from _throttled(specs, capacity, task.remote, wait_some, self.ray.get, on_start,
+                                  claim)  # fmt: skip
         finally:
             if started_here:
                 self.ray.shutdown()

@@ -17,6 +17,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
+from baselines.atomic_files import write_atomic
 from baselines.benchmark.grid import RunSpec, train_command
 
 __all__ = ["FAILED_FILE", "RESULT_FILE", "execute_run", "write_outcome"]
@@ -93,20 +94,18 @@ def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
 
 
 def write_outcome(outcome: dict[str, Any], folder: str | Path) -> Path:
-    """Write a run's files and then ``result.json`` (or ``failed.json``) under ``folder``."""
+    """Write a run's files and then ``result.json`` (or ``failed.json``) under ``folder``,
+    each atomically: a reader or a killed driver never leaves half a file."""
     root = Path(folder)
     root.mkdir(parents=True, exist_ok=True)
     for rel, data in (outcome.get("files") or {}).items():
-        path = root / rel
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(data)
+        write_atomic(root / rel, data)
     record = {k: v for k, v in outcome.items() if k != "files"}
     if outcome.get("status") == "finished":
         (root / FAILED_FILE).unlink(missing_ok=True)
         record["command"] = record["command"].replace("RUN_DIR", shlex.quote(str(root)))
-        (root / "command.txt").write_text(record["command"] + "\n")
+        write_atomic(root / "command.txt", record["command"] + "\n")
         target = root / RESULT_FILE
     else:
         target = root / FAILED_FILE
-    target.write_text(json.dumps(record, indent=1, allow_nan=False) + "\n")
-    return target
+    return write_atomic(target, json.dumps(record, indent=1, allow_nan=False) + "\n")

@@ -13,12 +13,15 @@ import dataclasses
 import json
 import re
 import shlex
+import typing
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
+
+from baselines.value_types import describe, matches
 
 __all__ = [
     "EVAL_SEED",
@@ -37,6 +40,8 @@ TEST_SEED = 20_000
 """First held-out seed of the final scoring, disjoint from the seeds that picked the best."""
 
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*")
+#: What a recipe's ``demos`` path may say about its run (nothing else in braces).
+_PLACEHOLDER = re.compile(r"\{(env_id|seed)\}")
 #: ``sgc train`` options a recipe may set (TrainConfig fields the grid does not own).
 _OWNED = {
     "algo", "env_id", "seed", "out", "eval_freq", "eval_episodes", "eval_seed", "command",
@@ -51,6 +56,22 @@ def _train_fields() -> dict[str, Any]:
     from baselines.agents.train import TrainConfig
 
     return {f.name: f for f in dataclasses.fields(TrainConfig)}
+
+
+def _check_train_options(train: Mapping[str, Any], where: str) -> None:
+    """Each option's value against ``TrainConfig``'s type hints; ``demos`` placeholders."""
+    from baselines.agents.train import TrainConfig
+
+    hints = typing.get_type_hints(TrainConfig)
+    for name, value in train.items():
+        if matches(value, hints[name]) is False:
+            raise ValueError(f"{where}: train option {name} must be {describe(hints[name])}, "
+                             f"got {value!r}")  # fmt: skip
+    demos = train.get("demos")
+    if isinstance(demos, str) and ("{" in _PLACEHOLDER.sub("", demos)
+                                   or "}" in _PLACEHOLDER.sub("", demos)):  # fmt: skip
+        raise ValueError(f"{where}: demos {demos!r}: the only placeholders are {{env_id}} and "
+                         "{seed}")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -108,7 +129,8 @@ class RunSpec:
         train = {k: v for k, v in self.recipe.train.items()}
         demos = train.get("demos")
         if isinstance(demos, str):
-            train["demos"] = demos.format(env_id=self.env_id, seed=self.seed)
+            values = {"env_id": self.env_id, "seed": str(self.seed)}
+            train["demos"] = _PLACEHOLDER.sub(lambda m: values[m[1]], demos)
         return {
             "algo": self.recipe.algo, "env_id": self.env_id, "seed": self.seed,
             "timesteps": self.recipe.timesteps, "out": None if out is None else str(out),
@@ -175,7 +197,7 @@ def _recipe(entry: Any, where: str) -> Recipe:
         raise ValueError(f"{where}: algo must be one of {ALGORITHMS}, got {algo!r}")
     name = _check_name(entry.get("name", algo), where)
     timesteps = entry.get("timesteps")
-    if timesteps is not None and (not isinstance(timesteps, int) or timesteps < 0):
+    if timesteps is not None and (not matches(timesteps, int) or timesteps < 0):
         raise ValueError(f"{where}: timesteps must be an integer >= 0, got {timesteps!r}")
     env_kwargs = entry.get("env_kwargs") or {}
     train = entry.get("train") or {}
@@ -186,7 +208,10 @@ def _recipe(entry: Any, where: str) -> Recipe:
     if bad:
         raise ValueError(f"{where}: train option(s) {sorted(bad)} unknown or set by the grid; "
                          f"allowed: {sorted(allowed)}")  # fmt: skip
+    _check_train_options(train, where)
     hyperparams = entry.get("hyperparams")
+    if hyperparams is not None and not isinstance(hyperparams, str):
+        raise ValueError(f"{where}: hyperparams must be a folder name, got {hyperparams!r}")
     if hyperparams is not None and not Path(hyperparams).is_dir():
         raise ValueError(f"{where}: hyperparams folder {hyperparams!r} does not exist")
     envs = entry.get("envs") or []
@@ -210,7 +235,7 @@ def load_recipes(path: str | Path) -> list[Recipe]:
     try:
         data = yaml.safe_load(file.read_text())
     except yaml.YAMLError as exc:
-        raise ValueError(f"--recipes: {file}: bad YAML: {exc}") from exc
+        raise ValueError(f"--recipes: {file}: bad YAML: {' '.join(str(exc).split())}") from None
     entries = data.get("recipes") if isinstance(data, Mapping) else None
     if not isinstance(entries, list) or not entries:
         raise ValueError(f"--recipes: {file}: expected a non-empty list under 'recipes:'")
@@ -257,6 +282,7 @@ def build_grid(
 ) -> list[RunSpec]:
     """Every (recipe, env, seed), after checking the arguments (``ValueError`` naming them)."""
     from baselines.agents.hyperparams import load_hyperparams
+    from baselines.env_kwargs import check_env_kwargs
     from sgc_env import check_env_id
 
     if not recipes:
@@ -282,6 +308,7 @@ def build_grid(
         for recipe in recipes:
             if recipe.runs_on(env_id):
                 load_hyperparams(recipe.algo, env_id, recipe.hyperparams)  # fails early, naming it
+                check_env_kwargs(env_id, recipe.env_kwargs, f"recipe {recipe.name!r}: env_kwargs")
     for recipe in recipes:
         if not any(recipe.runs_on(e) for e in env_ids):
             raise ValueError(f"recipe {recipe.name!r}: none of its envs {list(recipe.envs)} is "

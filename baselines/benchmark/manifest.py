@@ -3,7 +3,8 @@
 Each entry says what the model is and how it came about (``file`` relative to the manifest,
 ``env_id``, ``algo``, ``demonstrations``, ``timesteps``, ``seed``, ``wall_time_s``,
 ``command``) and what it scores on held-out seeds (``result``). A model trained behind
-``VecNormalize`` ships with its statistics as ``<stem>.vecnormalize.pkl`` beside it, which
+``VecNormalize`` ships with its statistics as ``<stem>.vecnormalize.json`` beside it (plain
+JSON, :mod:`baselines.normalization`; no pickle is shipped), which
 :func:`baselines.policies.make_policy` restores. :func:`ship_model` copies a run's model in
 and writes its entry (``scripts/ship_model.py`` is its command line).
 """
@@ -69,6 +70,8 @@ def check_manifest(folder: str | Path = CHECKPOINTS) -> list[str]:
     problems += [f"{f}: listed, not in {root}" for f in listed if not (root / f).is_file()]
     present = sorted(p.name for p in root.glob("*.zip"))
     problems += [f"{f}: in {root}, not listed" for f in present if f not in listed]
+    problems += [f"{p.name}: a pickle; ship statistics as JSON (scripts/convert_models.py)"
+                 for p in sorted(root.glob("*.pkl"))]  # fmt: skip
     return problems
 
 
@@ -117,13 +120,16 @@ def ship_model(
     source = run_dir / f"{which}_model.zip"
     if not source.is_file():
         raise ValueError(f"run: no {source.name} in {run_dir}")
+    if (run_dir / "vecnormalize.pkl").is_file() and not (run_dir / "vecnormalize.json").is_file():
+        raise ValueError(f"run: {run_dir}/vecnormalize.pkl is a pickle; convert it first "
+                         "(scripts/convert_models.py, only for a run you trust)")  # fmt: skip
     config = json.loads(config_path.read_text())
     root = Path(folder)
     target = root / f"{name}.zip"
     shutil.copyfile(source, target)
-    stats = run_dir / "vecnormalize.pkl"
+    stats = run_dir / "vecnormalize.json"
     if stats.is_file():
-        shutil.copyfile(stats, root / f"{name}.vecnormalize.pkl")
+        shutil.copyfile(stats, root / f"{name}.vecnormalize.json")
     command_file = run_dir / "command.txt"  # written by `sgc benchmark`, path resolved
     command = command_file.read_text().strip() if command_file.is_file() else config["command"]
     train_config = config.get("train_config", {})

@@ -8,6 +8,7 @@ The command that reproduces the whole table heads the file.
 
 from __future__ import annotations
 
+import io
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -16,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from baselines.atomic_files import write_atomic
 from baselines.benchmark.aggregate import CONFIDENCE, learning_curve, performance_profile
 
 __all__ = ["format_ci", "markdown", "write_report"]
@@ -114,8 +116,10 @@ def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str
             ax.legend(fontsize=8)
         fig.tight_layout()
         path = out / f"{env_id}.png"
-        fig.savefig(path, dpi=110)
+        image = io.BytesIO()
+        fig.savefig(image, format="png", dpi=110)
         plt.close(fig)
+        write_atomic(path, image.getvalue())
         written.append(path)
     return written
 
@@ -127,7 +131,8 @@ def write_report(
     out: str | Path,
     plots: bool = True,
 ) -> list[Path]:
-    """Write ``leaderboard.json``, ``leaderboard.md`` and (``plots``) one PNG per env."""
+    """Write ``leaderboard.json``, ``leaderboard.md`` and (``plots``) one PNG per env, each
+    atomically (two benchmarks on one folder: the last to finish wins, whole)."""
     root = Path(out)
     root.mkdir(parents=True, exist_ok=True)
     curves = {
@@ -141,10 +146,9 @@ def write_report(
         for r in rows
     }
     data = {"meta": dict(meta), "rows": list(rows), "learning_curves": curves}
-    json_path = root / "leaderboard.json"
-    json_path.write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
-    md_path = root / "leaderboard.md"
-    md_path.write_text(markdown(rows, meta))
+    json_path = write_atomic(root / "leaderboard.json",
+                             json.dumps(data, indent=1, allow_nan=False) + "\n")  # fmt: skip
+    md_path = write_atomic(root / "leaderboard.md", markdown(rows, meta))
     written = [json_path, md_path]
     if plots:
         written += _plot_profiles(rows, runs, root)

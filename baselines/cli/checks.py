@@ -15,6 +15,7 @@ import json
 import math
 import os
 import shutil
+import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -22,6 +23,7 @@ from typing import Any
 
 __all__ = [
     "UsageError",
+    "add_trust_argument",
     "bounded_int",
     "env_kwargs",
     "existing_dir",
@@ -35,6 +37,7 @@ __all__ = [
     "positive_float",
     "positive_int",
     "staged_output",
+    "trust_model",
 ]
 
 
@@ -168,19 +171,48 @@ def env_kwargs(text: str) -> dict[str, Any]:
     return value
 
 
+def _move_files(stage: Path, out: Path, folder: str = "") -> None:
+    for src in sorted(p for p in (stage / folder).rglob("*") if p.is_file()):
+        dest = out / src.relative_to(stage)
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(src, dest)
+
+
 @contextlib.contextmanager
-def staged_output(out: Path) -> Iterator[Path]:
+def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[Path]:
     """A temporary folder next to ``out`` to write into; on success its files replace those
     of the same name under ``out`` (others there are kept), on any failure or interrupt it is
-    removed and ``out`` is left as it was."""
+    removed and ``out`` is left as it was, except for the subfolders ``keep_on_failure``
+    (e.g. a training run's checkpoints, new files that replace nothing whole)."""
     out = Path(out)
     out.absolute().parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.absolute().parent))
     try:
         yield stage
-        for src in sorted(p for p in stage.rglob("*") if p.is_file()):
-            dest = out / src.relative_to(stage)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(src, dest)
+        _move_files(stage, out)
+    except BaseException:
+        for folder in keep_on_failure:
+            _move_files(stage, out, folder)
+        raise
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def add_trust_argument(parser: argparse.ArgumentParser) -> None:
+    """``--trust-model``: load model files with SB3's unpickling (see baselines.model_files)."""
+    parser.add_argument(
+        "--trust-model", action="store_true",
+        help="unpickle model files (.zip fields, .vecnormalize.pkl) as SB3 does: a file can "
+        "run any code while it loads; only for files you made or trust. Default: load "
+        "without unpickling",
+    )  # fmt: skip
+
+
+def trust_model(args: argparse.Namespace, command: str) -> bool:
+    """``args.trust_model``, printing the risk to stderr when it is set."""
+    trust = bool(getattr(args, "trust_model", False))
+    if trust:
+        from baselines.model_files import TRUST_WARNING
+
+        print(f"sgc {command}: warning: {TRUST_WARNING}", file=sys.stderr)
+    return trust

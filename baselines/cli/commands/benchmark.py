@@ -3,7 +3,10 @@
 Writes ``OUT/runs/<env>/<recipe>/seed<N>/`` per run (``config.json``, ``command.txt``, the
 models, ``result.json``) and ``OUT/leaderboard.{md,json}`` plus one PNG per env
 (performance profile and learning curves). Rerunning the same command skips finished runs
-(and failed ones unless ``--retry-failed``). See docs/agents.md.
+(and failed ones unless ``--retry-failed``); a run is finished once its ``result.json`` is
+written, so a benchmark killed mid-grid (even by SIGKILL) resumes where it was. Two
+benchmarks on one ``--out`` share the work: each run is claimed by one of them
+(:mod:`baselines.benchmark.claims`) and every file is written atomically. See docs/agents.md.
 """
 
 from __future__ import annotations
@@ -106,13 +109,16 @@ def _read(path: Path) -> dict[str, Any]:
     return json.loads(path.read_text())
 
 
-def _run_grid(todo: list[Any], backend: Any, root: Path, console: Any) -> None:
+def _run_grid(todo: list[Any], backend: Any, root: Path, console: Any) -> list[str]:
+    """Run ``todo``; the ids of runs left to another ``sgc benchmark`` on this folder."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from baselines.benchmark.execute import write_outcome
+    from baselines.benchmark.claims import RunClaims
+    from baselines.benchmark.execute import RESULT_FILE
 
     counts = {"running": 0, "done": 0, "failed": 0}
     folders = {spec.run_id: spec.folder(root) for spec in todo}
+    claims, elsewhere = RunClaims(), []
 
     def status() -> str:
         return f"done {counts['done']}, running {counts['running']}, failed {counts['failed']}"
@@ -126,20 +132,44 @@ def _run_grid(todo: list[Any], backend: Any, root: Path, console: Any) -> None:
             counts["running"] += 1
             progress.update(task, description=status())
 
-        for outcome in backend.run([s.to_dict() for s in todo], on_start=started):
-            write_outcome(outcome, folders[outcome["run_id"]])
-            ok = outcome["status"] == "finished"
-            counts["running"] -= 1
-            counts["done" if ok else "failed"] += 1
-            progress.update(task, advance=1, description=status())
-            line = (f"{outcome['run_id']}: {'finished' if ok else 'FAILED'} in "
-                    f"{outcome['wall_time_s']:.0f} s")  # fmt: skip
-            if not ok:
-                line += f" ({outcome['error']}; see {folders[outcome['run_id']]}/failed.json)"
-            if console.is_terminal:
-                progress.console.print(line)
-            else:
-                print(line, flush=True)
+        def claim(spec: dict[str, Any]) -> bool:
+            """Another benchmark on this folder may hold the run, or have finished it."""
+            folder = folders[spec["run_id"]]
+            if claims.claim(folder) and not (folder / RESULT_FILE).is_file():
+                return True
+            claims.release(folder)
+            elsewhere.append(spec["run_id"])
+            progress.update(task, advance=1)
+            return False
+
+        try:
+            outcomes = backend.run([s.to_dict() for s in todo], on_start=started, claim=claim)
+            for outcome in outcomes:
+                _record(outcome, folders[outcome["run_id"]], counts, console, progress)
+                claims.release(folders[outcome["run_id"]])
+                progress.update(task, advance=1, description=status())
+        finally:
+            claims.release_all()
+    return elsewhere
+
+
+def _record(outcome: dict[str, Any], folder: Path, counts: dict[str, int], console: Any,
+            progress: Any) -> None:  # fmt: skip
+    """Write one run's outcome and say how it went."""
+    from baselines.benchmark.execute import write_outcome
+
+    write_outcome(outcome, folder)
+    ok = outcome["status"] == "finished"
+    counts["running"] -= 1
+    counts["done" if ok else "failed"] += 1
+    verdict = "finished" if ok else "FAILED"
+    line = f"{outcome['run_id']}: {verdict} in {outcome['wall_time_s']:.0f} s"
+    if not ok:
+        line += f" ({outcome['error']}; see {folder}/failed.json)"
+    if console.is_terminal:
+        progress.console.print(line)
+    else:
+        print(line, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -168,7 +198,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"{len(grid)} runs: {len(finished)} finished before, {len(failed_before)} failed "
           f"before{' (retrying)' if args.retry_failed else ' (skipped; --retry-failed)'}, "
           f"{len(todo)} to run on {backend.description}", flush=True)  # fmt: skip
-    _run_grid(todo, backend, root, console)
+    elsewhere = _run_grid(todo, backend, root, console)
+    if elsewhere:
+        print(f"{len(elsewhere)} run(s) left to another sgc benchmark on {root} (running or "
+              f"finished there): {', '.join(elsewhere)}", flush=True)  # fmt: skip
     results = [_read(s.folder(root) / RESULT_FILE) for s in grid
                if (s.folder(root) / RESULT_FILE).is_file()]  # fmt: skip
     failed = [_read(s.folder(root) / FAILED_FILE) for s in grid

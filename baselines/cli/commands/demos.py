@@ -83,8 +83,13 @@ def _run_minari(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.demos import record_demos
     from baselines.agents.pushes import Pushes
+    from baselines.env_kwargs import check_env_kwargs
 
     known_env_id(args.env)
+    try:
+        check_env_kwargs(args.env, args.env_kwargs, "--env-kwargs")
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     if args.format == "minari":
         return _run_minari(args)
     try:

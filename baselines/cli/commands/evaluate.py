@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import (
+    add_trust_argument,
     known_env_id,
     nonneg_float,
     nonneg_int,
@@ -24,6 +25,7 @@ from baselines.cli.checks import (
     positive_float,
     positive_int,
     staged_output,
+    trust_model,
 )
 from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 
@@ -108,6 +110,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--wide", action="store_true",
         help="print every scorecard column (default: a compact table that fits 80 columns)",
     )  # fmt: skip
+    add_trust_argument(parser)
     parser.add_argument(
         "--reward", default=None, metavar="MODE",
         help="the env's reward mode (gym.make(id, reward=MODE): schedule, distance, sparse); "
@@ -218,7 +221,7 @@ def _write_pair(result: Any, out: Path, plots: bool) -> None:
 def run(args: argparse.Namespace) -> int:
     from baselines.cli.console import make_console, summary_line
     from baselines.evaluation import evaluate, json_ready
-    from baselines.policies import policy_labels
+    from baselines.policies import policy_labels, trusted_models
     from sgc_env.metrics import Tolerances
 
     console = make_console(args.wide)
@@ -242,7 +245,7 @@ def run(args: argparse.Namespace) -> int:
     summaries = []
     # Written next to the output folder and moved in at the end: an interrupted run leaves
     # the earlier results whole.
-    with staged_output(root) as stage:
+    with staged_output(root) as stage, trusted_models(trust_model(args, "evaluate")):
         for env_id in envs:
             for spec, label in zip(policies, labels, strict=True):
                 folder = Path() if single else Path(env_id) / label

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from baselines.cli.checks import nonneg_int, out_dir
+from baselines.cli.checks import add_trust_argument, nonneg_int, out_dir, trust_model
 
 __all__ = ["add_arguments", "make_env", "run"]
 
@@ -31,6 +31,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--policy", default="expert", metavar="SPEC",
         help="expert | dynamic-constraints | minimum-jerk | random | SB3 .zip (default expert)",
     )  # fmt: skip
+    add_trust_argument(parser)
     parser.add_argument("--out", type=out_dir, default=None, help="output folder")
     parser.add_argument("--video", action="store_true", help="also write rollout.mp4")
     parser.add_argument(
@@ -84,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         label = policy_label(args.policy)
         out = args.out or Path("runs/rollout") / name / label
-        policy = make_policy(args.policy, env, seed=args.seed)
+        trust = trust_model(args, "rollout")
+        policy = make_policy(args.policy, env, seed=args.seed, trust_model=trust)
         frames: list[Any] | None = [] if args.video else None
         record = run_episode(policy, env, args.seed, keep_infos=True, frames=frames)
         traj = plots.trajectory_arrays(record.infos or [], record.initial_info)

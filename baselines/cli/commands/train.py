@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import shlex
 import sys
+from dataclasses import replace
+from pathlib import Path
 
 from baselines.cli.checks import (
     UsageError,
@@ -16,6 +19,7 @@ from baselines.cli.checks import (
     nonneg_int,
     out_dir,
     positive_int,
+    staged_output,
 )
 from baselines.cli.commands.demos import add_push_arguments, push_options
 from sgc_env.defaults import EVAL_SEED
@@ -95,6 +99,13 @@ def whole_rollouts(algo: str, env_id: str, timesteps: int | None, folder: str | 
     return math.ceil(timesteps / chunk) * chunk
 
 
+def _record_out(config: Path, out: Path) -> None:
+    """``config.json`` names the run folder, not the stage it was written in."""
+    data = json.loads(config.read_text())
+    data["train_config"]["out"] = str(out)
+    config.write_text(json.dumps(data, indent=1))
+
+
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.train import TrainConfig, train
     from baselines.cli.console import summary_line
@@ -124,7 +135,16 @@ def run(args: argparse.Namespace) -> int:
         checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
         command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip
-    result = train(cfg)
+    try:
+        if args.out is None:
+            result = train(cfg)
+        else:  # staged next to --out: an interrupted run leaves the earlier run's files whole
+            with staged_output(args.out, keep_on_failure=("checkpoints",)) as stage:
+                result = train(replace(cfg, out=stage))
+                _record_out(stage / "config.json", args.out)
+            result.model_path = args.out / "final_model.zip"
+    except ValueError as exc:  # a bad input file (demos, hyperparameters) found while training
+        raise UsageError(str(exc)) from None
     print(
         f"{args.algo} on {args.env}: {result.timesteps} steps, learn {result.learn_time_s:.1f} s "
         f"({result.steps_per_s:.0f} steps/s), total {result.wall_time_s:.1f} s"
