@@ -65,8 +65,7 @@ def allowed_classes() -> dict[str, type]:
     from stable_baselines3.sac import policies as sac
     from stable_baselines3.td3 import policies as td3
 
-    from baselines.agents.features import StandardizeObservation
-    from baselines.agents.hyperparams import _ACTIVATIONS
+    from baselines.agents.features import ACTIVATIONS, StandardizeObservation
     from baselines.agents.schedule_features import ScheduleFeatures
 
     classes: list[type] = [
@@ -75,7 +74,7 @@ def allowed_classes() -> dict[str, type]:
         td3.TD3Policy, td3.CnnPolicy, td3.MultiInputPolicy,
         torch_layers.FlattenExtractor, torch_layers.NatureCNN, torch_layers.CombinedExtractor,
         StandardizeObservation, ScheduleFeatures,
-        *(getattr(th.nn, name) for name in _ACTIVATIONS),
+        *(getattr(th.nn, name) for name in ACTIVATIONS),
         th.optim.Adam, th.optim.AdamW, th.optim.RMSprop, th.optim.SGD,
         buffers.RolloutBuffer, buffers.DictRolloutBuffer, buffers.ReplayBuffer,
         buffers.DictReplayBuffer, HerReplayBuffer,

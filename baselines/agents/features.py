@@ -15,7 +15,10 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
-__all__ = ["SCALE_FLOOR", "StandardizeObservation", "set_statistics"]
+__all__ = ["ACTIVATIONS", "SCALE_FLOOR", "StandardizeObservation", "set_statistics"]
+
+ACTIVATIONS = ("ReLU", "Tanh", "ELU", "LeakyReLU", "SiLU", "GELU", "Sigmoid")
+"""The ``torch.nn`` activations a hyperparameter file may name and a model file may carry."""
 
 SCALE_FLOOR = 0.05
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import yaml
 
+from baselines.agents.features import ACTIVATIONS
 from baselines.shipped import hyperparams_file
 from baselines.value_types import describe, matches
 
@@ -28,7 +29,6 @@ __all__ = [
     "parse_kwargs_string",
 ]
 
-_ACTIVATIONS = ("ReLU", "Tanh", "ELU", "LeakyReLU", "SiLU", "GELU", "Sigmoid")
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
 _STRING_KWARGS = ("policy_kwargs", "replay_buffer_kwargs")
 _ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std"}
@@ -59,7 +59,7 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
         if dotted.startswith(prefix):
             short = dotted[len(prefix) :]
             break
-    if short in _ACTIVATIONS:
+    if short in ACTIVATIONS:
         return getattr(nn, short)
     if short == "StandardizeObservation":
         from baselines.agents.features import StandardizeObservation
@@ -73,7 +73,7 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
         from stable_baselines3 import HerReplayBuffer
 
         return HerReplayBuffer
-    raise ValueError(f"{field_name}: name {dotted!r} is not allowed (activations: {_ACTIVATIONS})")
+    raise ValueError(f"{field_name}: name {dotted!r} is not allowed (activations: {ACTIVATIONS})")
 
 
 def _dotted(node: ast.AST) -> str | None:
