@@ -124,6 +124,7 @@ from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_resi
 from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
+from sgc_env.render.camera import View
 from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
 from sgc_env.rendering import available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
@@ -702,20 +703,25 @@ class SGCEnv(gym.Env):
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
             return None
-        if self._renderer is None:
-            self._renderer = SceneRenderer(self.width, self.height, self.camera)
-        end = self.max_steps * self.dt
-        positions = [state[0] for state in self._states]
+        view = self.camera_view()
         if self.render_mode == "human":
-            orbit = self._renderer.view(self.scenario, end, positions).orbit
-            if orbit is not None:
-                self.sim.point_gui_camera(*orbit)
+            if view.orbit is not None:
+                self.sim.point_gui_camera(*view.orbit)
             return None
+        assert self._renderer is not None  # made by camera_view
         props = self._props.at(self._tick * self.substeps) if self._prop_uids else []
         return self._renderer.frame(
-            self.scenario, end, self._tick * self.dt, positions,
+            view, self._tick * self.dt, [state[0] for state in self._states],
             [state[1] for state in self._states], self.task.points, props,
         )  # fmt: skip
+
+    def camera_view(self) -> View:
+        """The camera of the next ``render()``: ``view.project(points)`` gives pixels."""
+        self._check_open()
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self.width, self.height, self.camera)
+        positions = [state[0] for state in self._states]
+        return self._renderer.view(self.scenario, self.max_steps * self.dt, positions)
 
     def close(self) -> None:
         """Disconnect the PyBullet client (saved states go with it). Idempotent."""

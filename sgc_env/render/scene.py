@@ -66,7 +66,8 @@ class CameraSpec:
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(options) - known)
         if unknown:
-            hint = " (the frame size is width=, height=)" if {"width", "height"} & set(unknown) else ""
+            sized = {"width", "height"} & set(unknown)
+            hint = " (the frame size is width=, height=)" if sized else ""
             raise ValueError(
                 f"camera: unknown option(s) {unknown}; expected some of {sorted(known)}{hint}"
             )
@@ -75,7 +76,9 @@ class CameraSpec:
         if "target" in options:
             target = np.asarray(options["target"], float)
             if target.shape != (3,) or not np.all(np.isfinite(target)):
-                raise ValueError(f"camera: target must be 3 finite numbers, got {options['target']!r}")
+                raise ValueError(
+                    f"camera: target must be 3 finite numbers, got {options['target']!r}"
+                )
             options["target"] = tuple(float(x) for x in target)
         if ("target" in options) != ("distance" in options):
             raise ValueError("camera: give target and distance together")
@@ -140,8 +143,10 @@ class SceneRenderer:
         self._times: list[float] = []
 
     def _prepare(self, scenario: Scenario, end_time: float) -> None:
-        geometry = (tuple((b.shape, b.size, b.color) for b in scenario.bodies),
-                    tuple((p.name, p.shape, p.size, p.color, p.position) for p in scenario.props))  # fmt: skip
+        geometry = (
+            tuple((b.shape, b.size, b.color) for b in scenario.bodies),
+            tuple((p.name, p.shape, p.size, p.color, p.position) for p in scenario.props),
+        )
         points = scene_points(scenario, end_time)
         self._diagonal = max(float(np.linalg.norm(np.ptp(points, axis=0))), 0.5)
         nails = [np.array([g.nail for g in b.goals if g.nail is not None], float).reshape(-1, 3)
@@ -166,7 +171,9 @@ class SceneRenderer:
         self._scenario = scenario
         self._points, self._times = [], []
 
-    def view(self, scenario: Scenario, end_time: float, positions: Sequence[Sequence[float]]) -> View:
+    def view(
+        self, scenario: Scenario, end_time: float, positions: Sequence[Sequence[float]]
+    ) -> View:
         """The camera for a frame with the bodies at ``positions``."""
         if scenario is not self._scenario:
             self._prepare(scenario, end_time)
@@ -179,12 +186,11 @@ class SceneRenderer:
         return frame_points((bodies[:, None, :] + around).reshape(-1, 3), self.width,
                             self.height, yaw=spec.yaw, pitch=spec.pitch, fov=spec.fov)  # fmt: skip
 
-    def frame(self, scenario: Scenario, end_time: float, now: float,
-              positions: Sequence[Sequence[float]], orientations: Sequence[Sequence[float]],
-              points: Sequence[Sequence[float]],
+    def frame(self, view: View, now: float, positions: Sequence[Sequence[float]],
+              orientations: Sequence[Sequence[float]], points: Sequence[Sequence[float]],
               prop_positions: Sequence[Sequence[float]]) -> np.ndarray:  # fmt: skip
-        """An RGB frame (height, width, 3) uint8 of the scene at time ``now``."""
-        view = self.view(scenario, end_time, positions)
+        """An RGB frame (height, width, 3) uint8 of the scene at time ``now`` seen through
+        ``view`` (from :meth:`view`, which prepares the scenario)."""
         assert self._world is not None and self._painter is not None
         if self._times and now < self._times[-1]:
             self._points, self._times = [], []

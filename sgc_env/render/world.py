@@ -50,8 +50,10 @@ class RenderWorld:
             max(float(b.size[1]), rod_radius or 0.0) if b.shape == "rod" else 0.0
             for b in scenario.bodies
         ]
-        self.body_uids = [self._add(b.shape, b.size, b.color, r)
-                          for b, r in zip(scenario.bodies, self.rod_radius, strict=True)]  # fmt: skip
+        self.body_uids = [
+            self._add(b.shape, b.size, b.color, r)
+            for b, r in zip(scenario.bodies, self.rod_radius, strict=True)
+        ]
         self.prop_uids = [self._add(p.shape, p.size, p.color, 0.0) for p in scenario.props]
         for p in scenario.props:
             if p.name == "target" and p.shape == "box":
@@ -87,7 +89,8 @@ class RenderWorld:
 
     def update(self, positions: Sequence[Sequence[float]],
                orientations: Sequence[Sequence[float]],
-               prop_positions: Sequence[Sequence[float]]) -> list[Caster]:  # fmt: skip
+               prop_positions: Sequence[Sequence[float]] | Sequence[np.ndarray],
+               ) -> list[Caster]:  # fmt: skip
         """Pose every body and prop; returns the shadow casters of the scene."""
         casters: list[Caster] = []
         c = self.client
@@ -97,10 +100,10 @@ class RenderWorld:
             pos, orn = [float(x) for x in position], [float(x) for x in orientation]
             pybullet.resetBasePositionAndOrientation(uid, pos, orn, physicsClientId=c)
             casters.append(_caster(b.shape, b.size, np.asarray(pos), orn, radius))
-        for p, uid, position in zip(self.props, self.prop_uids, prop_positions, strict=True):
-            pos = [float(x) for x in position]
-            pybullet.resetBasePositionAndOrientation(uid, pos, [0, 0, 0, 1], physicsClientId=c)
-            casters.append(_caster(p.shape, p.size, np.asarray(pos), (0, 0, 0, 1), 0.0))
+        for p, uid, at in zip(self.props, self.prop_uids, prop_positions, strict=True):
+            where = [float(x) for x in at]
+            pybullet.resetBasePositionAndOrientation(uid, where, [0, 0, 0, 1], physicsClientId=c)
+            casters.append(_caster(p.shape, p.size, np.asarray(where), (0, 0, 0, 1), 0.0))
         return casters
 
     def close(self) -> None:
