@@ -111,7 +111,7 @@ def _axes(yaw: float, pitch: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return view[0, :3], view[1, :3], -view[2, :3]
 
 
-def frame_points(points: np.ndarray, width: int, height: int, *, yaw: float = 30.0,
+def frame_points(points: np.ndarray, width: int, height: int, *, yaw: float = -40.0,
                  pitch: float = -22.0, fov: float = 50.0, fill: float = 0.8) -> View:  # fmt: skip
     """An orbit camera from ``yaw``/``pitch``, looking at the middle of ``points`` (n, 3), that
     shows them all inside the central ``fill`` of the frame's width and height.

@@ -239,7 +239,10 @@ class Painter:
     def _paint_nails(self, image, view, depth, nails, color) -> None:
         px, visible = self._visible(view, depth, nails)
         fill = tuple(float(c) for c in color)
+        # 3 px dots with a 1 px ring at the demo's 960 px width, scaled down with the frame
+        scale = min(1.0, max(view.width / 960.0, 0.4))
+        outer, inner = round(4 * 16 * scale), round(3 * 16 * scale)
         for p in np.round(px[visible] * 16).astype(np.int32):
             centre = (int(p[0]), int(p[1]))
-            cv2.circle(image, centre, 4 * 16, (40, 40, 40), -1, cv2.LINE_AA, shift=4)
-            cv2.circle(image, centre, 3 * 16, fill, -1, cv2.LINE_AA, shift=4)
+            cv2.circle(image, centre, outer, (40, 40, 40), -1, cv2.LINE_AA, shift=4)
+            cv2.circle(image, centre, inner, fill, -1, cv2.LINE_AA, shift=4)

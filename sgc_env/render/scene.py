@@ -52,7 +52,7 @@ class CameraSpec:
     ``target`` and ``distance`` for a camera that never moves."""
 
     mode: str = "fixed"
-    yaw: float = 30.0
+    yaw: float = -40.0
     pitch: float = -22.0
     fov: float = 50.0
     target: tuple[float, float, float] | None = None
