@@ -112,6 +112,18 @@ def horizon_row(view: View) -> float:
     return float(view.project((view.eye + 1e5 * flat)[None])[0][0, 1])
 
 
+@dataclass(frozen=True)
+class _Scenery:
+    """The per-view constants of :meth:`Painter._scenery`."""
+
+    sky: np.ndarray
+    top: int
+    to_pixel: np.ndarray
+    full: np.ndarray
+    dark: np.ndarray
+    plain: np.ndarray
+
+
 class Painter:
     """Renders and composites one frame (see the module docstring).
 
@@ -125,6 +137,7 @@ class Painter:
                  haze: float = HAZE) -> None:  # fmt: skip
         self.client = client
         self.haze = haze
+        self._cached: tuple[tuple, _Scenery] | None = None
         self.set_scene(colors, nails)
         self._texture, self._tex_to_world = _floor_texture(check)
 
@@ -154,22 +167,27 @@ class Painter:
 
     def _background(self, view: View, casters: Sequence[Caster]) -> np.ndarray:
         """Sky above the horizon, the shaded, hazy checkered floor below it."""
+        scenery = self._scenery(view)
+        layer = scenery.sky.copy()
+        if scenery.top < view.height:
+            layer[scenery.top :] = self._floor(view, casters, scenery)
+        return layer
+
+    def _scenery(self, view: View) -> _Scenery:
+        """What does not move while the camera holds still: the sky, the floor's lit and
+        hazed checker and how much of it a full shadow takes away (cached per view)."""
+        key = (view.view, view.projection, view.width, view.height)
+        if self._cached is not None and self._cached[0] == key:
+            return self._cached[1]
         w, h = view.width, view.height
-        layer = np.empty((h, w, 3), np.uint8)
+        sky = np.empty((h, w, 3), np.uint8)
         horizon = horizon_row(view)
         top = int(np.clip(np.ceil(horizon), 0, h))
         if top > 0:
             rows = np.arange(top, dtype=np.float32)
             up = np.clip((horizon - rows) / (0.9 * h), 0.0, 1.0) ** 0.7
             band = SKY_HORIZON + (SKY_ZENITH - SKY_HORIZON) * up[:, None]
-            layer[:top] = band.astype(np.uint8)[:, None, :]
-        if top < h:
-            layer[top:] = self._floor(view, casters, top)
-        return layer
-
-    def _floor(self, view: View, casters: Sequence[Caster], top: int) -> np.ndarray:
-        """Image rows ``top:`` of the floor, computed at half resolution and scaled up."""
-        w, h = view.width, view.height
+            sky[:top] = band.astype(np.uint8)[:, None, :]
         hw, hh = (w + 1) // 2, (h - top + 1) // 2
         # half-resolution pixels of the rows below ``top``
         to_half = np.array([[0.5, 0.0, 0.0], [0.0, 0.5, -0.5 * top], [0.0, 0.0, 1.0]])
@@ -180,14 +198,6 @@ class Painter:
             self._texture, to_pixel @ self._tex_to_world, (hw, hh),
             flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_WRAP,
         ).astype(np.float32)  # fmt: skip
-        shade: np.ndarray = np.zeros((hh, hw), np.uint8)
-        for caster in casters:
-            outline, depth = view.project(caster.ground_outline())
-            if np.all(depth > 0.0):
-                pts = (outline - [0.0, top]) * 0.5
-                cv2.fillPoly(shade, [np.round(pts * 16).astype(np.int32)], 255,
-                             lineType=cv2.LINE_AA, shift=4)  # fmt: skip
-        soft = cv2.GaussianBlur(shade, (0, 0), 1.2).astype(np.float32) / 255.0
         # distance of each floor pixel along the view axis, a ratio of affine functions of
         # the pixel: (x, y, 1) ~ to_world @ (px, py, 1), distance = -(view row 2) @ (x, y, 0, 1)
         to_world = np.linalg.inv(to_pixel)
@@ -198,9 +208,39 @@ class Painter:
         den = to_world[2, 0] * gx + to_world[2, 1] * gy + to_world[2, 2]
         dist = (num[0] * gx + num[1] * gy + num[2]) / den
         haze = np.where(dist > 0.0, -np.expm1(-np.maximum(dist, 0.0) / self.haze), 1.0)
-        lit = checker * (1.0 - (1.0 - SHADOW) * soft)[..., None]
-        lit += (SKY_HORIZON.astype(np.float32) - lit) * haze[..., None].astype(np.float32)
-        half = np.clip(lit, 0, 255).astype(np.uint8)
+        clear = (1.0 - haze)[..., None].astype(np.float32)
+        # lit = checker (1 - (1 - SHADOW) soft) hazed towards the horizon colour:
+        # lit = full - dark * soft
+        full = checker * clear + SKY_HORIZON.astype(np.float32) * (1.0 - clear)
+        dark = checker * clear * np.float32(1.0 - SHADOW)
+        scenery = _Scenery(sky, top, to_pixel, full, dark,
+                           np.clip(full, 0, 255).astype(np.uint8))  # fmt: skip
+        self._cached = (key, scenery)
+        return scenery
+
+    def _floor(self, view: View, casters: Sequence[Caster], scenery: _Scenery) -> np.ndarray:
+        """Image rows ``top:`` of the floor, computed at half resolution and scaled up; only
+        the box around the shadows is recomputed each frame."""
+        w, h, top = view.width, view.height, scenery.top
+        hh, hw = scenery.full.shape[:2]
+        shade: np.ndarray = np.zeros((hh, hw), np.uint8)
+        for caster in casters:
+            outline, depth = view.project(caster.ground_outline())
+            if np.all(depth > 0.0):
+                pts = (outline - [0.0, top]) * 0.5
+                cv2.fillPoly(shade, [np.round(pts * 16).astype(np.int32)], 255,
+                             lineType=cv2.LINE_AA, shift=4)  # fmt: skip
+        half = scenery.plain.copy()
+        ys, xs = np.nonzero(shade.any(axis=1))[0], np.nonzero(shade.any(axis=0))[0]
+        if len(ys):
+            y0, y1 = max(int(ys[0]) - 5, 0), min(int(ys[-1]) + 6, hh)
+            x0, x1 = max(int(xs[0]) - 5, 0), min(int(xs[-1]) + 6, hw)
+            soft = cv2.GaussianBlur(shade[y0:y1, x0:x1], (0, 0), 1.2,
+                                    borderType=cv2.BORDER_CONSTANT)  # fmt: skip
+            box = np.s_[y0:y1, x0:x1]
+            amount = (soft.astype(np.float32) / 255.0)[..., None]
+            lit = scenery.full[box] - scenery.dark[box] * amount
+            half[box] = np.clip(lit, 0, 255).astype(np.uint8)
         return cv2.resize(half, (w, 2 * hh), interpolation=cv2.INTER_LINEAR)[: h - top]
 
     def _visible(self, view: View, depth, points) -> tuple[np.ndarray, np.ndarray]:
