@@ -120,8 +120,12 @@ def main() -> None:
     nails = [np.array([g.nail for g in b.goals]) for b in base.scenario.bodies]
     painter = Painter(client, [b.color for b in base.scenario.bodies], nails)
     trail = [Trail(np.array([[-6.0, 0.0, 3.0], [-5.0, 0.0, 3.2]]), np.array([1.9, 2.0]))] * 3
+    def moving_camera_frame():
+        painter.forget_view()  # the demo's camera moves every frame: no per-view cache
+        return painter.frame(view, trail, casters, 2.0)
+
     rows["demo frame: that render + sky, floor, shadows, trails, nails"] = per_frame(
-        lambda: painter.frame(view, trail, casters, 2.0)
+        moving_camera_frame
     )
     if args.images:
         import imageio.v2 as imageio

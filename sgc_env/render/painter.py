@@ -173,6 +173,10 @@ class Painter:
             layer[scenery.top :] = self._floor(view, casters, scenery)
         return layer
 
+    def forget_view(self) -> None:
+        """Drop the per-view cache (benchmarks of a camera that moves every frame)."""
+        self._cached = None
+
     def _scenery(self, view: View) -> _Scenery:
         """What does not move while the camera holds still: the sky, the floor's lit and
         hazed checker and how much of it a full shadow takes away (cached per view)."""
