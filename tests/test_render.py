@@ -187,3 +187,31 @@ def test_sb3_video_recorder_as_rl_zoo3_uses_it(tmp_path):
     videos = list(tmp_path.glob("zoo*.mp4"))
     assert len(videos) == 1
     _assert_watchable(videos[0], frames=30)
+
+
+def test_env_checkers_pass_with_rendering():
+    import warnings
+
+    from gymnasium.utils.env_checker import check_env
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+    env = gym.make("SGCRod-v0", render_mode="rgb_array", width=64, height=48)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=False)
+        sb3_check_env(env.unwrapped)
+    env.close()
+
+
+def test_a_rendered_env_pickles_and_renders_again():
+    import pickle
+
+    env = SGCEnv("rod_basic", render_mode="rgb_array", width=64, height=48, camera="tracking")
+    env.reset()
+    env.step(np.full(6, 0.1, np.float32))
+    first = env.render()
+    copy = pickle.loads(pickle.dumps(env))
+    assert (copy.width, copy.height, copy.camera.mode) == (64, 48, "tracking")
+    assert np.array_equal(copy.render(), first)
+    env.close()
+    copy.close()
