@@ -14,6 +14,7 @@ rings of the paper's board on its -x face.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -44,6 +45,8 @@ class RenderWorld:
 
     def __init__(self, scenario: Scenario, rod_radius: float | None = None) -> None:
         self.client = pybullet.connect(pybullet.DIRECT)
+        # an env dropped without close() still frees this client when it is collected
+        self._finalizer = weakref.finalize(self, _disconnect, self.client)
         self.bodies = scenario.bodies
         self.props = scenario.props
         self.rod_radius = [
@@ -107,12 +110,16 @@ class RenderWorld:
         return casters
 
     def close(self) -> None:
-        if self.client >= 0:
-            try:
-                pybullet.disconnect(physicsClientId=self.client)
-            except pybullet.error:
-                pass
-            self.client = -1
+        """Disconnect the render client (idempotent)."""
+        self._finalizer()
+        self.client = -1
+
+
+def _disconnect(client: int) -> None:
+    try:
+        pybullet.disconnect(physicsClientId=client)
+    except pybullet.error:
+        pass
 
 
 def _caster(shape: str, size: Sequence[float], centre: np.ndarray,
