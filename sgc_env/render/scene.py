@@ -182,7 +182,7 @@ class SceneRenderer:
         if spec.mode == "fixed" or spec.target is not None:
             return self._fixed
         bodies = np.asarray(positions, float).reshape(-1, 3)
-        around = 0.12 * self._diagonal * np.r_[np.eye(3), -np.eye(3)]
+        around = 0.25 * self._diagonal * np.r_[np.eye(3), -np.eye(3)]
         return frame_points((bodies[:, None, :] + around).reshape(-1, 3), self.width,
                             self.height, yaw=spec.yaw, pitch=spec.pitch, fov=spec.fov)  # fmt: skip
 
