@@ -25,6 +25,7 @@ import cv2
 import numpy as np
 
 from baselines.cli.demo_camera import camera_at
+from baselines.episode_gif import gif_durations, write_gif
 from sgc_env.paper.end_rules import END_RULES
 from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
@@ -241,13 +242,6 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
     }  # fmt: skip
 
 
-def gif_durations(count: int, fps: float) -> list[int]:
-    """Per-frame GIF delays (ms) summing to real time: GIF delays are whole centiseconds, so
-    a 1000/fps delay that is not one is spread (66.7 ms -> 70, 70, 60)."""
-    ends = np.round(np.arange(1, count + 1) * 100.0 / fps).astype(int) * 10
-    return np.diff(np.r_[0, ends]).tolist()
-
-
 def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
 
@@ -258,23 +252,10 @@ def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict
     step = options.gif_scale
     small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)
              for f in frames[::2]]  # fmt: skip
-    _write_gif(gif, small, gif_durations(len(small), VIDEO_FPS / 2))
+    write_gif(gif, small, gif_durations(len(small), VIDEO_FPS / 2))
     plates = options.out / "plates.png"
     imageio.imwrite(plates, plate_sheet(frames, times))
     return {"three_rods.mp4": mp4, "three_rods.gif": gif, "plates.png": plates}
-
-
-def _write_gif(path: Path, frames: Sequence[np.ndarray], durations: Sequence[int]) -> None:
-    """Pillow GIF with a fast octree palette per frame (median cut costs ~3x the CPU)."""
-    from PIL import Image
-
-    images = [
-        Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
-                                    dither=Image.Dither.FLOYDSTEINBERG)
-        for f in frames
-    ]  # fmt: skip
-    images[0].save(path, save_all=True, append_images=images[1:], duration=list(durations),
-                   loop=0, optimize=False)  # fmt: skip
 
 
 def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:

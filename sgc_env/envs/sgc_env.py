@@ -125,8 +125,8 @@ from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.render.camera import View
+from sgc_env.render.modes import available_render_modes
 from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
-from sgc_env.rendering import available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.simulator import Drive, Simulator
 

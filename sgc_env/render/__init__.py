@@ -3,7 +3,8 @@
 :mod:`~sgc_env.render.camera` (views, eased shots, a camera framing a box),
 :mod:`~sgc_env.render.painter` (sky, floor, shadows, trails, nails around TinyRenderer),
 :mod:`~sgc_env.render.world` (visual-only copies of a scene in a client of their own) and
-:mod:`~sgc_env.render.scene` (what the env draws each frame).
+:mod:`~sgc_env.render.scene` (what the env draws each frame) and
+:mod:`~sgc_env.render.modes` (which render modes this machine offers).
 """
 
 from sgc_env.render.camera import Shot, View, camera_at, frame_points, orbit_view

@@ -1,4 +1,4 @@
-"""Which render modes this machine offers; the drawing itself is in :mod:`sgc_env.render`."""
+"""Which render modes this machine offers (the drawing is elsewhere in :mod:`sgc_env.render`)."""
 
 from __future__ import annotations
 
