@@ -86,7 +86,7 @@ def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str |
         "## Held-out results",
         "",
         f"Measured by the card step ({time.strftime('%Y-%m-%d')}, {evaluated_on}, "
-        f"{eval_seconds:.0f} s), with the harness of `sgc evaluate`:",
+        f"{eval_seconds:.0f} s wall), with the harness of `sgc evaluate`:",
         "",
         "| | |",
         "|---|---|",
@@ -121,7 +121,8 @@ def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str |
 def write_model_card(entry: Mapping[str, Any], *, episodes: int = 10, seed: int | None = None,
                      gif: bool = True, folder: Path = CHECKPOINTS) -> Path:  # fmt: skip
     """Evaluate the model of ``entry`` on ``episodes`` held-out seeds from ``seed`` (default:
-    the manifest result's first seed), draw its GIF and write ``<stem>.md`` beside it."""
+    the manifest result's first seed), draw its GIF (``gif=False`` keeps an existing one) and
+    write ``<stem>.md`` beside it."""
     from baselines.episode_gif import episode_gif
 
     if episodes < 1:
@@ -134,11 +135,10 @@ def write_model_card(entry: Mapping[str, Any], *, episodes: int = 10, seed: int 
     started = time.perf_counter()
     fresh = held_out_result(model, entry["env_id"], episodes, first)
     seconds = time.perf_counter() - started
-    link = None
+    path = DOCS_IMAGES / f"model_{stem}.gif"
     if gif:
-        path = episode_gif(entry["env_id"], str(model), DOCS_IMAGES / f"model_{stem}.gif",
-                           seed=first, fps=8.0)  # fmt: skip
-        link = os.path.relpath(path, folder)
+        episode_gif(entry["env_id"], str(model), path, seed=first, fps=8.0)
+    link = os.path.relpath(path, folder) if path.is_file() else None
     card = folder / f"{stem}.md"
     card.write_text(card_markdown(entry, fresh, link, machine(), seconds))
     return card

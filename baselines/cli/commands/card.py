@@ -21,7 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="held-out episodes the card evaluates")  # fmt: skip
     parser.add_argument("--seed", type=nonneg_int, default=None,
                         help="first held-out seed (default: the manifest result's)")  # fmt: skip
-    parser.add_argument("--no-gif", action="store_true", help="skip the episode GIF")
+    parser.add_argument("--no-gif", action="store_true",
+                        help="do not redraw the episode GIF (an existing one stays linked)")  # fmt: skip
 
 
 def run(args: argparse.Namespace) -> int:
