@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=nonneg_int, default=None,
                         help="first held-out seed (default: the manifest result's)")  # fmt: skip
     parser.add_argument("--no-gif", action="store_true",
-                        help="do not redraw the episode GIF (an existing one stays linked)")  # fmt: skip
+                        help="keep the episode GIF there is (no new episode drawn)")  # fmt: skip
 
 
 def run(args: argparse.Namespace) -> int:
