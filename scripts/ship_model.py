@@ -11,8 +11,9 @@ or, for a model already in the folder whose run is gone, the facts by hand::
         --algo ppo --demonstrations --timesteps 0 --train-seed 0 --wall-time 139 \
         --command "sgc train ..." [--episodes 50] [--seed 10000]
 
-Either way the model is scored with the harness on held-out seeds and the entry replaces
-any entry for the same file.
+Either way the model is scored with the harness on held-out seeds, the entry replaces
+any entry for the same file, and the model card is written beside the model
+(``baselines/model_cards.py``; ``--card-episodes 0`` skips it, ``sgc card STEM`` redoes it).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import argparse
 import json
 
 from baselines.benchmark.manifest import CHECKPOINTS, held_out_result, ship_model, write_entry
+from baselines.model_cards import write_model_card
 
 
 def main() -> None:
@@ -39,6 +41,8 @@ def main() -> None:
     parser.add_argument("--train-seed", type=int, default=0, help="--existing: training seed")
     parser.add_argument("--wall-time", type=float, help="--existing: training wall time (s)")
     parser.add_argument("--command", help="--existing: the command that trained it")
+    parser.add_argument("--card-episodes", type=int, default=10,
+                        help="held-out episodes the model card evaluates (0: no card)")  # fmt: skip
     args = parser.parse_args()
     if args.run:
         if not args.name:
@@ -62,6 +66,8 @@ def main() -> None:
         }  # fmt: skip
         write_entry(entry)
     print(json.dumps(entry, indent=1))
+    if args.card_episodes > 0:
+        print(write_model_card(entry, episodes=args.card_episodes))
 
 
 if __name__ == "__main__":

@@ -163,20 +163,23 @@ def test_gif_delays_add_up_to_real_time():
 
 def test_pierced_balls_ride_their_rods():
     env = gym.make("SGCThreeRods-v0")
-    env.reset(seed=0)
+    _, info = env.reset(seed=0)
     base = env.unwrapped
-    scene = DemoScene(base.sim, base.scenario)
-    client = base.sim.client
+    scene = DemoScene(base.scenario)
+    client = scene.client
+    positions, orientations = info["body_position"], info["body_orientation"]
     before = three_rods.PIERCE_TIME - 0.5
-    scene.update(before)
-    for ball, uid in zip(scene.balls, scene.ball_uids, strict=True):
+    scene.update(before, positions, orientations)
+    balls = [base.scenario.props[k] for k in scene.ball_index]
+    for ball, uid in zip(balls, scene.ball_uids, strict=True):
         at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
         np.testing.assert_allclose(at, ball.position_at(before), atol=1e-12)
-    scene.update(three_rods.PIERCE_TIME + 1.0)  # slid to the middle of the rod
+    scene.update(three_rods.PIERCE_TIME + 1.0, positions, orientations)  # slid to the middle
     for rod, uid in zip(scene.rods, scene.ball_uids, strict=True):
         centre = pybullet.getBasePositionAndOrientation(rod, physicsClientId=client)[0]
         at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
         np.testing.assert_allclose(at, centre, atol=1e-12)
+    scene.close()
     env.close()
 
 
@@ -195,11 +198,11 @@ def test_demo_options_are_validated():
 
 def test_target_board_whole_in_frame_once_the_flight_is_on():
     """From 2.6 s (the wide shot) to the end, all 8 corners of the board project inside."""
-    from baselines.cli.demo import _box_corners
+    from sgc_env.render import box_corners
 
     scenario = sgc_env.load_scenario("three_rods")
     board = next(p for p in scenario.props if p.name == "target")
-    corners = _box_corners(board.position, board.size)
+    corners = box_corners(board.position, board.size)
     end = max(float(g.time) for b in scenario.bodies for g in b.goals) + scenario.margin
     for t in np.arange(2.6, end, 1.0 / 30.0):
         view = camera_at(float(t), 960, 540)

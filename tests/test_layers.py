@@ -85,10 +85,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("sgc_env.scenario",),
     ("sgc_env.scenes",),
     ("sgc_env.episode_steps", "sgc_env.observation", "sgc_env.simulator", "sgc_env.metrics"),
-    ("sgc_env.rendering",),
+    ("sgc_env.render",),
     ("sgc_env.envs",),
     ("sgc_env",),  # the package: registers the ids
-    ("sgc_env.ladder",),
+    ("sgc_env.ladder", "sgc_env.env_cards"),
     ("baselines.vector", "baselines.observation_fields", "baselines.minimum_jerk",
      "baselines.tracking", "baselines.dynamic_constraints", "baselines.shipped"),
     ("baselines.atomic_files", "baselines.value_types", "baselines.env_kwargs",
@@ -100,8 +100,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.comparison_policies",),
     ("baselines.policies", "baselines"),
     ("baselines.evaluation",),
+    ("baselines.episode_gif",),
     ("baselines.agents",),
     ("baselines.benchmark",),
+    ("baselines.model_cards",),
     ("baselines.cli",),
 )  # fmt: skip
 """The parts of ``sgc_env`` and ``baselines``, bottom up: a part imports only parts of lower

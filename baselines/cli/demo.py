@@ -2,11 +2,12 @@
 
 One episode of ``SGCThreeRods-v0`` driven by :class:`baselines.SGCExpert` (the tangent
 end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``), scored by
-the shared harness, and rendered headless: TinyRenderer for the bodies, then the look of
-:mod:`baselines.cli.demo_view` (sky, checkered floor, shadows, fading trails, nails) from the
-cameras of :mod:`baselines.cli.demo_camera`. Rods are drawn thicker than their physical
-radius, and each red ball, once pierced, rides on its rod into the target (visual only: the
-balls are kinematic props, physics is untouched). Outputs: an MP4 and a GIF at real time, an
+the shared harness, and rendered headless through the renderer of ``env.render()``
+(:mod:`sgc_env.render`: TinyRenderer for the bodies, then sky, checkered floor, shadows,
+fading trails, nails) from the cameras of :mod:`baselines.cli.demo_camera`. Rods are drawn
+thicker than their physical radius, and each red ball, once pierced, rides on its rod into the
+target (visual only: the render world is a client of its own, physics is untouched).
+Outputs: an MP4 and a GIF at real time, an
 8-frame plate sheet in the spirit of the paper's Plates 1-8, deviation and speed plots per rod
 (named and coloured as in the video), ``goals.csv``, ``summary.json`` and ``rods.json``.
 """
@@ -24,9 +25,10 @@ import cv2
 import numpy as np
 
 from baselines.cli.demo_camera import camera_at
-from baselines.cli.demo_view import TRAIL_SECONDS, Caster, DemoPainter, Trail
+from baselines.episode_gif import gif_durations, write_gif
 from sgc_env.paper.end_rules import END_RULES
-from sgc_env.simulator import Simulator, pybullet
+from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
+from sgc_env.simulator import pybullet
 
 __all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
 
@@ -84,73 +86,37 @@ def cpu_seconds() -> float:
 
 
 class DemoScene:
-    """The visual-only dressing: bullseye, thick rod shells, carried balls."""
+    """The demo's render world (thick rod shells, the bullseye board) with the pierced balls
+    carried on their rods."""
 
-    def __init__(self, sim: Simulator, scenario: Any) -> None:
+    def __init__(self, scenario: Any) -> None:
         from sgc_env.scenes import three_rods
 
-        self.sim = sim
-        client = sim.client
-        props = {p.name: p for p in scenario.props}
-        self.target = props["target"]
-        _bullseye(client, self.target.position, self.target.size)
-        self.rods = [sim.bodies[b.name].uid for b in scenario.bodies]
-        self.shells = []
-        for body in scenario.bodies:
-            shape = pybullet.createVisualShape(
-                pybullet.GEOM_CYLINDER, radius=ROD_DRAW_RADIUS, length=float(body.size[0]),
-                rgbaColor=list(body.color), physicsClientId=client,
-            )  # fmt: skip
-            self.shells.append(pybullet.createMultiBody(0.0, -1, shape, [0, 0, -1e3],
-                                                        physicsClientId=client))  # fmt: skip
-        self.balls = [props[f"ball_{b.name[4:]}"] for b in scenario.bodies]
-        self.ball_uids = [sim.bodies[p.name].uid for p in self.balls]
+        self.world = RenderWorld(scenario, ROD_DRAW_RADIUS)
+        self.client = self.world.client
+        self.props = scenario.props
+        ball_names = [f"ball_{b.name[4:]}" for b in scenario.bodies]
+        self.ball_index = [[p.name for p in scenario.props].index(n) for n in ball_names]
+        self.ball_uids = [self.world.prop_uids[k] for k in self.ball_index]
+        self.rods = self.world.body_uids
         self.tip = np.asarray(three_rods.TIP, float)
         self.pierce_time = three_rods.PIERCE_TIME
 
-    def update(self, now: float) -> list[Caster]:
-        """Place shells and balls for time ``now``; the shadow casters of the scene."""
-        client = self.sim.client
-        casters = [Caster(corners=_box_corners(self.target.position, self.target.size))]
-        for rod, shell, ball, ball_uid in zip(self.rods, self.shells, self.balls, self.ball_uids,
-                                              strict=True):  # fmt: skip
-            position, orientation = pybullet.getBasePositionAndOrientation(
-                rod, physicsClientId=client
-            )
-            self.sim.move(shell, position, orientation)
-            axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
-            centre = np.asarray(position)
-            casters.append(Caster(centre - axis @ self.tip, centre + axis @ self.tip,
-                                  ROD_DRAW_RADIUS))  # fmt: skip
-            if now >= self.pierce_time:
-                slide = min((now - self.pierce_time) / BALL_SLIDE, 1.0)
-                along = self.tip * (1.0 - slide * slide * (3.0 - 2.0 * slide))
-                ball_at = centre + axis @ along
-            else:
-                ball_at = np.asarray(ball.position_at(now))
-            self.sim.move(ball_uid, tuple(ball_at.tolist()))
-            casters.append(Caster(ball_at, None, float(ball.size[0])))
-        return casters
+    def update(self, now: float, positions: Sequence[Sequence[float]],
+               orientations: Sequence[Sequence[float]]) -> list[Caster]:  # fmt: skip
+        """Pose rods (as the env has them) and props for time ``now``; the shadow casters."""
+        props = [np.asarray(p.position_at(now), float) for p in self.props]
+        if now >= self.pierce_time:
+            slide = min((now - self.pierce_time) / BALL_SLIDE, 1.0)
+            along = self.tip * (1.0 - slide * slide * (3.0 - 2.0 * slide))
+            for k, position, orientation in zip(self.ball_index, positions, orientations,
+                                                strict=True):  # fmt: skip
+                axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+                props[k] = np.asarray(position, float) + axis @ along
+        return self.world.update(positions, orientations, props)
 
-
-def _box_corners(centre: Sequence[float], half: Sequence[float]) -> np.ndarray:
-    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    return np.asarray(centre, float) + signs * np.asarray(half, float)
-
-
-def _bullseye(client: int, target_center: Sequence[float], board_half: Sequence[float]) -> None:
-    """Rings on the target board's face (visual only)."""
-    face_x = target_center[0] - board_half[0] - 0.005
-    rings = ((1.6, (0.85, 0.1, 0.1, 1.0)), (1.1, (0.95, 0.95, 0.95, 1.0)),
-             (0.6, (0.85, 0.1, 0.1, 1.0)), (0.2, (0.95, 0.85, 0.2, 1.0)))  # fmt: skip
-    turn = pybullet.getQuaternionFromEuler([0.0, np.pi / 2, 0.0])
-    for k, (radius, color) in enumerate(rings):
-        disc = pybullet.createVisualShape(
-            pybullet.GEOM_CYLINDER, radius=radius, length=0.01, rgbaColor=list(color),
-            physicsClientId=client,
-        )  # fmt: skip
-        position = [face_x - 0.006 * k, target_center[1], target_center[2]]
-        pybullet.createMultiBody(0.0, -1, disc, position, turn, physicsClientId=client)
+    def close(self) -> None:
+        self.world.close()
 
 
 def run_demo(
@@ -182,16 +148,16 @@ def run_demo(
     scene: Any = None
     painter: Any = None
     if options.video:
-        scene = DemoScene(base.sim, scenario)
+        scene = DemoScene(scenario)
         nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
-        painter = DemoPainter(base.sim.client, [b.color for b in scenario.bodies], nails)
+        painter = Painter(scene.client, [b.color for b in scenario.bodies], nails)
 
     def on_step(env_: Any, step: int, info: Mapping[str, Any]) -> None:
         now = float(info.get("time", 0.0))
         tips.append(np.asarray(info["point_position"], float))
         tip_times.append(now)
         if painter is not None and scene is not None and step % frame_every == 0:
-            casters = scene.update(now)
+            casters = scene.update(now, info["body_position"], info["body_orientation"])
             view = camera_at(now, options.width, options.height)
             frames.append(painter.frame(view, _trails(tips, tip_times, now), casters, now))
             frame_times.append(now)
@@ -201,6 +167,8 @@ def run_demo(
     expert = SGCExpert(env, end_rule=options.end_rule)
     record = run_episode(expert, env, seed=0, keep_infos=True, on_step=on_step)
     env.close()
+    if scene is not None:
+        scene.close()
 
     result = DemoResult()
     label = "expert" if options.end_rule == "tangent" else "expert-paper"
@@ -273,13 +241,6 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
     }  # fmt: skip
 
 
-def gif_durations(count: int, fps: float) -> list[int]:
-    """Per-frame GIF delays (ms) summing to real time: GIF delays are whole centiseconds, so
-    a 1000/fps delay that is not one is spread (66.7 ms -> 70, 70, 60)."""
-    ends = np.round(np.arange(1, count + 1) * 100.0 / fps).astype(int) * 10
-    return np.diff(np.r_[0, ends]).tolist()
-
-
 def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
 
@@ -290,23 +251,10 @@ def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict
     step = options.gif_scale
     small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)
              for f in frames[::2]]  # fmt: skip
-    _write_gif(gif, small, gif_durations(len(small), VIDEO_FPS / 2))
+    write_gif(gif, small, gif_durations(len(small), VIDEO_FPS / 2))
     plates = options.out / "plates.png"
     imageio.imwrite(plates, plate_sheet(frames, times))
     return {"three_rods.mp4": mp4, "three_rods.gif": gif, "plates.png": plates}
-
-
-def _write_gif(path: Path, frames: Sequence[np.ndarray], durations: Sequence[int]) -> None:
-    """Pillow GIF with a fast octree palette per frame (median cut costs ~3x the CPU)."""
-    from PIL import Image
-
-    images = [
-        Image.fromarray(f).quantize(256, method=Image.Quantize.FASTOCTREE,
-                                    dither=Image.Dither.FLOYDSTEINBERG)
-        for f in frames
-    ]  # fmt: skip
-    images[0].save(path, save_all=True, append_images=images[1:], duration=list(durations),
-                   loop=0, optimize=False)  # fmt: skip
 
 
 def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:

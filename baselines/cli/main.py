@@ -23,6 +23,7 @@ COMMANDS: dict[str, str] = {
     "evaluate": "score policies on envs with the shared harness: tables, CSV, JSON, plots",
     "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
     "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
+    "card": "write the model cards of shipped models, with a fresh held-out evaluation",
 }
 
 

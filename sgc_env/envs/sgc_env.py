@@ -97,8 +97,10 @@ goal orientation, in [0, pi], at that tick; None for a missing part).
 ``sgc_env.scenes.PRESETS`` or a config of a scene family, redrawn from ``np_random``
 on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_frequency``
 (240 Hz, an integer multiple of the control frequency), ``time_grid`` ("reject" or "snap"),
-``render_mode`` ("human" uses a GUI client, "rgb_array" the TinyRenderer), ``camera`` (dict of
-distance, yaw, pitch, target, width, height), ``reward`` (``"schedule"``, ``"distance"`` or
+``render_mode`` ("human" uses a GUI client, "rgb_array" the look of :mod:`sgc_env.render`),
+``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
+:class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
+``reward`` (``"schedule"``, ``"distance"`` or
 ``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
 plain reset).
@@ -120,7 +122,9 @@ import numpy as np
 from sgc_env.episode_steps import scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.paper.quaternion import rotate, rotate_back
-from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
+from sgc_env.render.camera import View
+from sgc_env.render.modes import available_render_modes
+from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.scenes import PRESETS, SceneFamily
 from sgc_env.scenes import random_scenario as draw_random_scenario
@@ -245,14 +249,16 @@ class SGCEnv(gym.Env):
         sim_frequency: int = 240,
         time_grid: str | None = None,
         render_mode: str | None = None,
-        camera: dict[str, Any] | None = None,
+        camera: str | dict[str, Any] | None = None,
+        width: int = 640,
+        height: int = 480,
         reward: str = "schedule",
     ) -> None:
         self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
-            "reward": reward,
+            "width": width, "height": height, "reward": reward,
         }  # fmt: skip
         self.reward_mode = reward
         self._reward: RewardFunction = make_reward(reward)
@@ -263,7 +269,8 @@ class SGCEnv(gym.Env):
                 "give a scenario (object, built-in name or YAML path) or random_scenario"
             )
         self.render_mode = render_mode
-        self.camera = CameraConfig.from_dict(camera)
+        self.camera = CameraSpec.parse(camera)
+        self.width, self.height = check_size("width", width), check_size("height", height)
         self._random_config: SceneFamily | None = None
         if scenario is None:
             cfg = (
@@ -313,7 +320,7 @@ class SGCEnv(gym.Env):
         self.observation_space = gym.spaces.Box(
             -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
         )
-        self._markers: NailMarkers | None = None
+        self._renderer: SceneRenderer | None = None
         self._closed = False
         self.scenario: Scenario = base
         self._geometry: tuple = ()
@@ -356,8 +363,6 @@ class SGCEnv(gym.Env):
         self._prop_uids = [self.sim.bodies[p.name].uid for p in s.props]
         self.body_inertia = np.array([self.sim.inertia_diagonal(b.name) for b in s.bodies])
         self._geometry = _geometry(s)
-        if self._markers is not None:
-            self._markers.clear()
 
     def _set_scenario(self, s: Scenario) -> None:
         """Switch to ``s`` all at once: everything is checked and compiled before the env
@@ -410,8 +415,6 @@ class SGCEnv(gym.Env):
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
-        if self._markers is not None:
-            self._markers.place(s)
 
     # ---------------------------------------------------------------- reset / step
 
@@ -694,20 +697,37 @@ class SGCEnv(gym.Env):
     # ---------------------------------------------------------------- rendering
 
     def render(self) -> np.ndarray | None:
+        """``rgb_array``: a (height, width, 3) uint8 frame with the look of ``sgc demo``
+        (:mod:`sgc_env.render`); ``human``: points the GUI window's camera the same way."""
         self._check_open()
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to the env")
             return None
-        if self._markers is None:
-            self._markers = NailMarkers(self.sim)
-            self._markers.place(self.scenario)
-        if self.render_mode == "rgb_array":
-            return self.camera.image(self.sim)
-        self.camera.point_gui(self.sim)
-        return None
+        view = self.camera_view()
+        if self.render_mode == "human":
+            if view.orbit is not None:
+                self.sim.point_gui_camera(*view.orbit)
+            return None
+        assert self._renderer is not None  # made by camera_view
+        props = self._props.at(self._tick * self.substeps) if self._prop_uids else []
+        return self._renderer.frame(
+            view, self._tick * self.dt, [state[0] for state in self._states],
+            [state[1] for state in self._states], self.task.points, props,
+        )  # fmt: skip
+
+    def camera_view(self) -> View:
+        """The camera of the next ``render()``: ``view.project(points)`` gives pixels."""
+        self._check_open()
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self.width, self.height, self.camera)
+        positions = [state[0] for state in self._states]
+        return self._renderer.view(self.scenario, self.max_steps * self.dt, positions)
 
     def close(self) -> None:
         """Disconnect the PyBullet client (saved states go with it). Idempotent."""
+        renderer = getattr(self, "_renderer", None)
+        if renderer is not None:
+            renderer.close()
         sim = getattr(self, "sim", None)
         if sim is not None:
             sim.close()
