@@ -14,7 +14,8 @@ For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=.
 the unwrapped env, the ratio random / fixed, how many feasibility checks (``demand_bounds``
 calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
 one check, and for scale the stepping time of a full-length episode of the random id (mean
-step time under seeded random actions times the episode's steps).
+step time under seeded random actions times the episode's steps). Last, where the CPU time
+of those random ids' resets goes (``PHASES``; ``env``: everything else, the env's own part).
 
     .venv/bin/python scripts/bench_random_scenes.py [--resets 20] [--rounds 3]
 """
@@ -23,11 +24,15 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections import defaultdict
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
+from sgc_env.scenario import demand
 from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
 TARGET_MS = 10.0
@@ -119,6 +124,59 @@ def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
 
 
+PHASES = (
+    ("plan", demand, "body_plan"),
+    ("bound", intercept, "demand_bounds"),
+    ("bound", three_rods_random, "demand_bounds"),
+    ("build", three_rods_random, "build_three_rods"),
+    ("parse", three_rods_random, "scenario_from_dict"),
+    ("resolve", intercept, "resolve_scenario"),
+    ("resolve", three_rods_random, "resolve_scenario"),
+)
+"""Where a draw's CPU time goes: the planner, the bound's sampling of the plan (``bound``
+minus ``plan``), building the rods' YAML-ready data, parsing it, resolving the goal times."""
+
+
+@contextmanager
+def _timed(seconds: dict[str, float]) -> Iterator[None]:
+    """Add each phase's process CPU time to ``seconds`` while the block runs."""
+    saved = [(module, name, getattr(module, name)) for _, module, name in PHASES]
+
+    def timer(key: str, fn):
+        def timed(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                seconds[key] += time.process_time() - start
+
+        return timed
+
+    for (key, module, name), (_, _, fn) in zip(PHASES, saved, strict=True):
+        setattr(module, name, timer(key, fn))
+    try:
+        yield
+    finally:
+        for module, name, fn in saved:
+            setattr(module, name, fn)
+
+
+def _split_ms(env_id: str, resets: int) -> dict[str, float]:
+    """CPU ms per ``reset(seed=...)`` of each phase, and ``env`` for the rest of the reset."""
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    seconds: dict[str, float] = defaultdict(float)
+    with _timed(seconds):
+        start = time.process_time()
+        for seed in range(1, resets + 1):
+            env.reset(seed=seed)
+        total = time.process_time() - start
+    env.close()
+    seconds["bound"] -= seconds["plan"]
+    seconds["env"] = total - sum(seconds.values())
+    return {key: value / resets * 1e3 for key, value in seconds.items()}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resets", type=int, default=20)
@@ -147,6 +205,12 @@ def main() -> None:
         print(f"{fixed:24s} {base:9.2f}")
         print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
               f" {episode:11.1f}")  # fmt: skip
+    print()
+    keys = ("plan", "bound", "build", "parse", "resolve", "env")
+    print(f"{'CPU ms per reset':24s}" + "".join(f"{k:>9s}" for k in keys))
+    for _, random_id, _ in PAIRS:
+        split = _split_ms(random_id, args.resets)
+        print(f"{random_id:24s}" + "".join(f"{split.get(k, 0.0):9.2f}" for k in keys))
 
 
 if __name__ == "__main__":
