@@ -2,31 +2,41 @@
 in the same run.
 
 First, for every id registered with a random scene family: the mean ``env.reset(seed=...)``
-time on the unwrapped env, its ratio to a bare PyBullet reset measured in the same run
-(one body of a DIRECT client put back to its start pose and velocity), and
-the redraw rate (feasibility checks per kept scene; ``-`` for families whose draw is feasible
-by construction and never checks). Then, as before:
+time on the unwrapped env over ``--rounds`` rounds; the same in process CPU time (``cpu ms``:
+what other jobs on a shared machine inflate least, and PyBullet DIRECT runs in this process);
+the wall time's ratio to a bare PyBullet reset measured in the same run (one body of a DIRECT
+client put back to its start pose and velocity); its share of stepping a full-length episode
+(``% episode``); the redraw rate (feasibility checks per kept scene; ``-`` for families whose
+draw is feasible by construction and never checks); and whether the wall time (``yes``), only
+the CPU time (``cpu``) or neither (``no``) stays within issue 19's 10 ms. Then, as before:
 
 For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
 the unwrapped env, the ratio random / fixed, how many feasibility checks (``demand_bounds``
 calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
 one check, and for scale the stepping time of a full-length episode of the random id (mean
-step time under seeded random actions times the episode's steps).
+step time under seeded random actions times the episode's steps). Last, where the CPU time
+of those random ids' resets goes (``PHASES``; ``env``: everything else, the env's own part).
 
-    .venv/bin/python scripts/bench_random_scenes.py [--resets 20]
+    .venv/bin/python scripts/bench_random_scenes.py [--resets 20] [--rounds 3]
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from collections import defaultdict
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
+from sgc_env.scenario import demand
 from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
+TARGET_MS = 10.0
+"""Issue 19's bound on a random id's reset (about a tenth of its episode's steps)."""
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
          ("SGCThreeRods-v0", "SGCThreeRodsRandom-v0", "three_rods"))  # fmt: skip
 
@@ -58,14 +68,19 @@ def _random_ids() -> list[tuple[str, str]]:
     return out
 
 
-def _reset_ms(env_id: str, resets: int) -> float:
+def _reset_ms(env_id: str, resets: int, rounds: int = 1) -> tuple[float, float]:
+    """Mean ``reset(seed=...)`` ms over ``rounds`` rounds of ``resets`` seeds (the same seeds
+    each round): wall-clock and process CPU time."""
     env = gym.make(env_id).unwrapped
     env.reset(seed=0)
-    start = time.perf_counter()
-    for seed in range(1, resets + 1):
-        env.reset(seed=seed)
+    wall, cpu = time.perf_counter(), time.process_time()
+    for _ in range(rounds):
+        for seed in range(1, resets + 1):
+            env.reset(seed=seed)
+    count = rounds * resets
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     env.close()
-    return (time.perf_counter() - start) / resets * 1e3
+    return wall / count * 1e3, cpu / count * 1e3
 
 
 def _episode_ms(env_id: str, steps: int) -> float:
@@ -109,29 +124,93 @@ def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
 
 
+PHASES = (
+    ("plan", demand, "body_plan"),
+    ("bound", intercept, "demand_bounds"),
+    ("bound", three_rods_random, "demand_bounds"),
+    ("build", three_rods_random, "build_three_rods"),
+    ("parse", three_rods_random, "scenario_from_dict"),
+    ("resolve", intercept, "resolve_scenario"),
+    ("resolve", three_rods_random, "resolve_scenario"),
+)
+"""Where a draw's CPU time goes: the planner, the bound's sampling of the plan (``bound``
+minus ``plan``), building the rods' YAML-ready data, parsing it, resolving the goal times."""
+
+
+@contextmanager
+def _timed(seconds: dict[str, float]) -> Iterator[None]:
+    """Add each phase's process CPU time to ``seconds`` while the block runs."""
+    saved = [(module, name, getattr(module, name)) for _, module, name in PHASES]
+
+    def timer(key: str, fn):
+        def timed(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                seconds[key] += time.process_time() - start
+
+        return timed
+
+    for (key, module, name), (_, _, fn) in zip(PHASES, saved, strict=True):
+        setattr(module, name, timer(key, fn))
+    try:
+        yield
+    finally:
+        for module, name, fn in saved:
+            setattr(module, name, fn)
+
+
+def _split_ms(env_id: str, resets: int) -> dict[str, float]:
+    """CPU ms per ``reset(seed=...)`` of each phase, and ``env`` for the rest of the reset."""
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    seconds: dict[str, float] = defaultdict(float)
+    with _timed(seconds):
+        start = time.process_time()
+        for seed in range(1, resets + 1):
+            env.reset(seed=seed)
+        total = time.process_time() - start
+    env.close()
+    seconds["bound"] -= seconds["plan"]
+    seconds["env"] = total - sum(seconds.values())
+    return {key: value / resets * 1e3 for key, value in seconds.items()}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--resets", type=int, default=20)
+    parser.add_argument("--rounds", type=int, default=3, help="rounds of the first table")
     args = parser.parse_args()
     bare = _bare_reset_ms(2000)
     print(f"bare PyBullet reset: {bare * 1e3:.1f} us")
-    print(f"{'id':24s} {'reset ms':>9s} {'x bare':>8s} {'checks/scene':>12s}")
+    print(f"{'id':24s} {'reset ms':>9s} {'cpu ms':>8s} {'x bare':>8s} {'% episode':>9s}"
+          f" {'checks/scene':>12s} {'<= 10 ms':>9s}")  # fmt: skip
     for env_id, preset in _random_ids():
-        ms = _reset_ms(env_id, args.resets)
+        ms, cpu = _reset_ms(env_id, args.resets, args.rounds)
         draws, _ = _draws_per_scene(preset, args.resets)
         rate = f"{draws:12.2f}" if draws else f"{'-':>12s}"
-        print(f"{env_id:24s} {ms:9.2f} {ms / bare:8.0f} {rate}")
+        verdict = "yes" if ms <= TARGET_MS else ("cpu" if cpu <= TARGET_MS else "no")
+        share = 100 * ms / _episode_ms(env_id, 1000)
+        print(f"{env_id:24s} {ms:9.2f} {cpu:8.2f} {ms / bare:8.0f} {share:9.1f} {rate}"
+              f" {verdict:>9s}")  # fmt: skip
     print()
     print(f"{'id':24s} {'reset ms':>9s} {'x fixed':>8s} {'checks/scene':>12s} {'check ms':>9s}"
           f" {'episode ms':>11s}")  # fmt: skip
     for fixed, random_id, family in PAIRS:
-        base = _reset_ms(fixed, args.resets)
-        drawn = _reset_ms(random_id, args.resets)
+        base, _ = _reset_ms(fixed, args.resets)
+        drawn, _ = _reset_ms(random_id, args.resets)
         draws, check_ms = _draws_per_scene(family, args.resets)
         episode = _episode_ms(random_id, 2000)
         print(f"{fixed:24s} {base:9.2f}")
         print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
               f" {episode:11.1f}")  # fmt: skip
+    print()
+    keys = ("plan", "bound", "build", "parse", "resolve", "env")
+    print(f"{'CPU ms per reset':24s}" + "".join(f"{k:>9s}" for k in keys))
+    for _, random_id, _ in PAIRS:
+        split = _split_ms(random_id, args.resets)
+        print(f"{random_id:24s}" + "".join(f"{split.get(k, 0.0):9.2f}" for k in keys))
 
 
 if __name__ == "__main__":
