@@ -27,7 +27,14 @@ from baselines.cli.checks import (
 )
 from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 
-__all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
+__all__ = [
+    "SCORECARD_COLUMNS",
+    "SMOOTHNESS_COLUMNS",
+    "add_arguments",
+    "expand_envs",
+    "markdown_table",
+    "run",
+]
 
 #: (summary key, column title, format) of the comparison table.
 SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
@@ -42,6 +49,13 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("speed_minima_mean", "speed minima / ep", ".1f"),
     ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
     ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
+    ("ldlj_track_mean", "LDLJ track", ".2f"),
+    ("acceleration_peak_max", "peak accel (m/s²)", ".1f"),
+    ("acceleration_kink_max", "accel kink max (m/s²)", ".2f"),
+    ("angular_velocity_jump_max", "ang vel jump max (rad/s)", ".3f"),
+    ("angular_ldlj_track_mean", "ang LDLJ track", ".2f"),
+    ("angular_acceleration_peak_max", "peak ang accel (rad/s²)", ".1f"),
+    ("angular_acceleration_kink_max", "ang accel kink max (rad/s²)", ".2f"),
     ("force_peak_max", "peak force (N)", ".1f"),
     ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
     ("terminated", "terminated", "d"),
@@ -56,6 +70,19 @@ COMPACT_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("position_error_max", "pos err\nmax (m)", ".1e"),
     ("orientation_error_max", "ori err\nmax (rad)", ".1e"),
     ("position_closest_offset_abs_max", "offset\nmax (s)", ".3f"),
+)
+
+#: The smoothness table printed under the compact one: LDLJ over the whole track, peak
+#: acceleration and the largest one-tick change of acceleration (the kink), linear and angular.
+SMOOTHNESS_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("ldlj_track_mean", "LDLJ\ntrack", ".2f"),
+    ("acceleration_peak_max", "peak acc\n(m/s²)", ".1f"),
+    ("acceleration_kink_max", "kink\n(m/s²)", ".2f"),
+    ("angular_ldlj_track_mean", "ang LDLJ\ntrack", ".2f"),
+    ("angular_acceleration_peak_max", "peak ang acc\n(rad/s²)", ".1f"),
+    ("angular_acceleration_kink_max", "ang kink\n(rad/s²)", ".2f"),
 )
 
 #: Per-goal table of a single pair: (row key, full title, compact title, format).
@@ -168,9 +195,15 @@ def _table(title: str, wide: bool) -> Any:
     return Table(title=title, box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
 
 
-def _rich_table(summaries: Sequence[Mapping[str, Any]], title: str, wide: bool = False) -> Any:
+def _rich_table(
+    summaries: Sequence[Mapping[str, Any]],
+    title: str,
+    wide: bool = False,
+    columns: Sequence[tuple[str, str, str]] | None = None,
+) -> Any:
     table = _table(title, wide)
-    columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
+    if columns is None:
+        columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
     for _, name, fmt in columns:
         text = fmt == "s"
         table.add_column(name, justify="left" if text else "right", overflow="fold")
@@ -267,6 +300,9 @@ def run(args: argparse.Namespace) -> int:
             (stage / "scorecard.md").write_text(markdown_table(summaries))
     title = f"{args.episodes} episode(s) from seed {args.seed}"
     console.print(_rich_table(summaries, title, args.wide))
+    if not args.wide:
+        smooth_title = "smoothness: LDLJ over the track, peak and one-tick change of acceleration"
+        console.print(_rich_table(summaries, smooth_title, columns=SMOOTHNESS_COLUMNS))
     console.print(f"[dim]wrote {root}[/dim]")
     console.print(summary_line(summaries[0]) if single else _goals_met_line(summaries))
     return 0
