@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -92,3 +93,20 @@ def test_velocity_jump_counts_the_step_into_the_goal():
     times = np.array([0.1, 0.2, 0.3, 0.4])
     v = np.array([0.0, 0.0, 2.0, 2.1])  # the ramp is in the step that ends on the goal at 0.3
     assert velocity_jump(times, v, 0.3) == pytest.approx(2.0)
+
+
+def test_rollout_and_evaluate_report_the_angular_figures(tmp_path, capsys):
+    from baselines.cli import main as cli
+
+    argv = ["rollout", "--env", "SGCRod-v0", "--seed", "4", "--no-compare"]
+    assert cli.main([*argv, "--out", str(tmp_path / "ro")]) == 0
+    out = capsys.readouterr().out
+    assert "angular: LDLJ track" in out and "largest one-tick change of acceleration" in out
+    argv = ["evaluate", "--env", "SGCRod-v0", "--episodes", "1", "--no-plots"]
+    assert cli.main([*argv, "--out", str(tmp_path / "ev")]) == 0
+    out = capsys.readouterr().out
+    assert "ang kink" in out and "ang LDLJ" in out
+    summary = json.loads((tmp_path / "ev" / "summary.json").read_text())
+    for key in ("angular_acceleration_kink_max", "angular_acceleration_peak_max",
+                "angular_ldlj_track_mean", "angular_ldlj_mean", "acceleration_kink_max"):  # fmt: skip
+        assert math.isfinite(summary[key]), key

@@ -129,12 +129,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def smoothness_line(card: dict[str, Any]) -> str:
-    """The episode's smoothness, linear and angular: LDLJ over the track, peak acceleration
-    and the largest one-tick change of acceleration (docs/metrics.md)."""
+    """The episode's smoothness, linear and angular: LDLJ over the track (mean over bodies),
+    peak acceleration and the largest one-tick change of acceleration (the largest over
+    bodies; docs/metrics.md)."""
     parts = []
     for prefix, unit, name in (("", "m/s²", "linear"), ("angular_", "rad/s²", "angular")):
         values = [card[f"{prefix}{k}"] for k in
-                  ("ldlj_track", "acceleration_peak", "acceleration_kink")]  # fmt: skip
+                  ("ldlj_track_mean", "acceleration_peak", "acceleration_kink")]  # fmt: skip
         if all(isinstance(v, float) and math.isnan(v) for v in values):
             continue
         parts.append(
