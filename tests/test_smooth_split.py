@@ -107,6 +107,7 @@ def test_rollout_and_evaluate_report_the_angular_figures(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "ang kink" in out and "ang LDLJ" in out
     summary = json.loads((tmp_path / "ev" / "summary.json").read_text())
-    for key in ("angular_acceleration_kink_max", "angular_acceleration_peak_max",
-                "angular_ldlj_track_mean", "angular_ldlj_mean", "acceleration_kink_max"):  # fmt: skip
+    keys = ("angular_acceleration_kink_max", "angular_acceleration_peak_max",
+            "angular_ldlj_track_mean", "angular_ldlj_mean", "acceleration_kink_max")  # fmt: skip
+    for key in keys:
         assert math.isfinite(summary[key]), key
