@@ -111,3 +111,40 @@ def test_rollout_and_evaluate_report_the_angular_figures(tmp_path, capsys):
             "angular_ldlj_track_mean", "angular_ldlj_mean", "acceleration_kink_max")  # fmt: skip
     for key in keys:
         assert math.isfinite(summary[key]), key
+
+
+def _kink_rows(episodes: int) -> list[dict]:
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / "kink_table.py"
+    spec = importlib.util.spec_from_file_location("kink_table", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rows = module.compare("SGCThreeRods-v0", 1, 0, "expert")
+    return rows + module.compare("SGCThreeRodsRandom-v0", episodes, 10000, "expert")
+
+
+@pytest.mark.slow
+def test_kinks_against_minimum_jerk_what_holds():
+    """Issue 23's must-show, the part that holds (scripts/kink_table.py prints the table):
+    every goal met, the paper scene's somersault rod turns at most as kinked as minimum jerk,
+    and no rod's linear kink exceeds 3x minimum jerk's."""
+    rows = _kink_rows(5)
+    assert all(r["met"] == r["goals"] for r in rows)
+    teal = rows[1]
+    assert teal["angular_acceleration_kink_ratio"] <= 1.0
+    assert max(r["acceleration_kink_ratio"] for r in rows) <= 3.0
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="angular kinks at goals: 3-17x minimum jerk's (issue 23)")
+def test_kinks_against_minimum_jerk_every_rod_within_2x():
+    """The must-show in full; it does not hold yet: SGC courses are C1 at goals and a stateless
+    expert sees only two courses, so the acceleration jumps at orientation goals
+    (docs/smoothness.md)."""
+    rows = _kink_rows(5)
+    for r in rows:
+        assert r["acceleration_kink_ratio"] <= 2.0
+        assert r["angular_acceleration_kink_ratio"] <= 2.0
