@@ -75,6 +75,8 @@ SMOOTH_PIECE_ANGLE = math.pi / 8.0
 """Target rotation of one sub-course of a smooth split (:func:`split_rotation` with paces):
 short enough that the sub-courses' average rates follow the rate profile closely."""
 
+_MAX_PIECES = math.ceil(MAX_RELATIVE_ROTATION / MAX_COURSE_ROTATION)
+
 SMOOTH_PIECE_TICKS = 4
 """Fewest control ticks per sub-course of a smooth split (fewer pieces when time is short)."""
 
@@ -148,7 +150,8 @@ def split_rotation(
         )
     smooth = rate_in is not None and rate_out is not None and m > 1
     if smooth:
-        wanted = math.ceil(angle / SMOOTH_PIECE_ANGLE - 1e-12)
+        # no more courses than the longest equal split (96): bounds the planner's work
+        wanted = min(math.ceil(angle / SMOOTH_PIECE_ANGLE - 1e-12), _MAX_PIECES)
         m = max(m, min(wanted, (k1 - k0) // SMOOTH_PIECE_TICKS) if f is not None else wanted)
     if f is None:
         ends = [t1 if i == m else t0 + (t1 - t0) * i / m for i in range(1, m + 1)]
