@@ -72,16 +72,14 @@ COMPACT_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("position_closest_offset_abs_max", "offset\nmax (s)", ".3f"),
 )
 
-#: The smoothness table printed under the compact one: LDLJ over the whole track, peak
-#: acceleration and the largest one-tick change of acceleration (the kink), linear and angular.
+#: The smoothness table printed under the compact one: LDLJ over the whole track and the
+#: largest one-tick change of acceleration (the kink), linear and angular (peaks: ``--wide``).
 SMOOTHNESS_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("env_id", "env", "s"),
     ("policy", "policy", "s"),
     ("ldlj_track_mean", "LDLJ\ntrack", ".2f"),
-    ("acceleration_peak_max", "peak acc\n(m/s²)", ".1f"),
     ("acceleration_kink_max", "kink\n(m/s²)", ".2f"),
     ("angular_ldlj_track_mean", "ang LDLJ\ntrack", ".2f"),
-    ("angular_acceleration_peak_max", "peak ang acc\n(rad/s²)", ".1f"),
     ("angular_acceleration_kink_max", "ang kink\n(rad/s²)", ".2f"),
 )
 
@@ -301,7 +299,7 @@ def run(args: argparse.Namespace) -> int:
     title = f"{args.episodes} episode(s) from seed {args.seed}"
     console.print(_rich_table(summaries, title, args.wide))
     if not args.wide:
-        smooth_title = "smoothness: LDLJ over the track, peak and one-tick change of acceleration"
+        smooth_title = "smoothness: LDLJ over the track, one-tick change of acceleration"
         console.print(_rich_table(summaries, smooth_title, columns=SMOOTHNESS_COLUMNS))
     console.print(f"[dim]wrote {root}[/dim]")
     console.print(summary_line(summaries[0]) if single else _goals_met_line(summaries))
