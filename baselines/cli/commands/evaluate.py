@@ -30,6 +30,7 @@ from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANC
 __all__ = [
     "SCORECARD_COLUMNS",
     "SMOOTHNESS_COLUMNS",
+    "SMOOTHNESS_WIDE_COLUMNS",
     "add_arguments",
     "expand_envs",
     "markdown_table",
@@ -49,13 +50,8 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("speed_minima_mean", "speed minima / ep", ".1f"),
     ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
     ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
-    ("ldlj_track_mean", "LDLJ track", ".2f"),
-    ("acceleration_peak_max", "peak accel (m/s²)", ".1f"),
-    ("acceleration_kink_max", "accel kink max (m/s²)", ".2f"),
-    ("angular_velocity_jump_max", "ang vel jump max (rad/s)", ".3f"),
-    ("angular_ldlj_track_mean", "ang LDLJ track", ".2f"),
-    ("angular_acceleration_peak_max", "peak ang accel (rad/s²)", ".1f"),
-    ("angular_acceleration_kink_max", "ang accel kink max (rad/s²)", ".2f"),
+    ("acceleration_kink_max", "kink (m/s²)", ".2f"),
+    ("angular_acceleration_kink_max", "ang kink (rad/s²)", ".2f"),
     ("force_peak_max", "peak force (N)", ".1f"),
     ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
     ("terminated", "terminated", "d"),
@@ -81,6 +77,15 @@ SMOOTHNESS_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("acceleration_kink_max", "kink\n(m/s²)", ".2f"),
     ("angular_ldlj_track_mean", "ang LDLJ\ntrack", ".2f"),
     ("angular_acceleration_kink_max", "ang kink\n(rad/s²)", ".2f"),
+)
+
+#: The smoothness table with ``--wide``: peaks and the angular velocity jump too.
+SMOOTHNESS_WIDE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    *SMOOTHNESS_COLUMNS[:4],
+    ("acceleration_peak_max", "peak acc\n(m/s²)", ".1f"),
+    *SMOOTHNESS_COLUMNS[4:],
+    ("angular_acceleration_peak_max", "peak ang acc\n(rad/s²)", ".1f"),
+    ("angular_velocity_jump_max", "ang vel jump\nmax (rad/s)", ".3f"),
 )
 
 #: Per-goal table of a single pair: (row key, full title, compact title, format).
@@ -298,9 +303,9 @@ def run(args: argparse.Namespace) -> int:
             (stage / "scorecard.md").write_text(markdown_table(summaries))
     title = f"{args.episodes} episode(s) from seed {args.seed}"
     console.print(_rich_table(summaries, title, args.wide))
-    if not args.wide:
-        smooth_title = "smoothness: LDLJ over the track, one-tick change of acceleration"
-        console.print(_rich_table(summaries, smooth_title, columns=SMOOTHNESS_COLUMNS))
+    smooth_title = "smoothness: LDLJ over the track, one-tick change of acceleration (kink)"
+    smooth = SMOOTHNESS_WIDE_COLUMNS if args.wide else SMOOTHNESS_COLUMNS
+    console.print(_rich_table(summaries, smooth_title, args.wide, columns=smooth))
     console.print(f"[dim]wrote {root}[/dim]")
     console.print(summary_line(summaries[0]) if single else _goals_met_line(summaries))
     return 0
