@@ -96,9 +96,16 @@ class Scorecard(TypedDict):
     sparc_mean: float
     sparc_track_mean: float
     ldlj_mean: float
+    ldlj_track_mean: float
     angular_sparc_mean: float
+    angular_ldlj_mean: float
+    angular_ldlj_track_mean: float
     velocity_jump_max: float
     angular_velocity_jump_max: float
+    acceleration_peak_max: float
+    acceleration_kink_max: float
+    angular_acceleration_peak_max: float
+    angular_acceleration_kink_max: float
     speed_minima_mean: float
     goal_speed_ratio_min: float
     rotation_ratio_max: float
@@ -321,9 +328,17 @@ def summarize(
         "sparc_mean": _mean(c["sparc_mean"] for c in cards),
         "sparc_track_mean": _mean(c["sparc_track_mean"] for c in cards),
         "ldlj_mean": _mean(c["ldlj_mean"] for c in cards),
+        "ldlj_track_mean": _mean(c["ldlj_track_mean"] for c in cards),
         "angular_sparc_mean": _mean(c["angular_sparc_mean"] for c in cards),
+        "angular_ldlj_mean": _mean(c["angular_ldlj_mean"] for c in cards),
+        "angular_ldlj_track_mean": _mean(c["angular_ldlj_track_mean"] for c in cards),
         "velocity_jump_max": _max(c["velocity_jump_max"] for c in cards),
         "angular_velocity_jump_max": _max(c["angular_velocity_jump_max"] for c in cards),
+        **{
+            f"{key}_max": _max(c[key] for c in cards)
+            for key in ("acceleration_peak", "acceleration_kink", "angular_acceleration_peak",
+                        "angular_acceleration_kink")
+        },  # fmt: skip
         "speed_minima_mean": _mean(c["speed_minima_total"] for c in cards),
         "goal_speed_ratio_min": _min(b["goal_speed_ratio_min"] for b in bodies),
         "rotation_ratio_max": _max(c["rotation_ratio_max"] for c in cards),

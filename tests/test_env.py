@@ -303,12 +303,13 @@ def _somersault_env(time: float, check_plan: bool = True) -> SGCEnv:
 
 def test_somersault_is_split_into_courses_tracked_continuously():
     # A deviation of 2 pi sits on the singular shell of the rotation vector, so the env splits
-    # the somersault into three 2 pi / 3 courses; the rotation still left (phi plus the
-    # courses not started yet) must fall smoothly from -2 pi to 0.
+    # the somersault into courses; entered and left at its own pace, the smooth split is 15
+    # equal courses of 4 ticks (about pi / 8 each, at least 4 ticks); the rotation still left
+    # (phi plus the courses not started yet) must fall smoothly from -2 pi to 0.
     env = _somersault_env(1.0)
     obs, _ = env.reset()
     sl = env.layout.body_slice(0, "orientation_deviation")
-    piece = -2.0 * math.pi / 3.0
+    piece = -2.0 * math.pi / 15.0
     np.testing.assert_allclose(obs[sl], [piece, 0, 0], atol=1e-6)
     np.testing.assert_allclose(
         obs[env.layout.body_slice(0, "orientation_course_start")], [piece, 0, 0], rtol=1e-6
@@ -316,7 +317,7 @@ def test_somersault_is_split_into_courses_tracked_continuously():
     remaining, events = [], []
     for k in range(60):
         obs, *_, info = env.step(np.zeros(6, np.float32))
-        courses_left = 2 - min(2, (k + 1) // 20)
+        courses_left = 14 - min(14, (k + 1) // 4)
         remaining.append(obs[sl][0] + courses_left * piece)
         events += info.get("goal_reached", [])
     # coasting at 2 pi rad/s for 1 s completes the somersault

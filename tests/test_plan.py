@@ -122,10 +122,10 @@ def test_somersault_completes_with_the_right_angle():
     axis = np.array([1.0, 0.0, 1.0]) / math.sqrt(2)
     rel = 1.5 * 2 * math.pi * axis
     plan = plan_body(_state(), [], [OrientationGoal(2.0, relative_rotation=rel)])
-    # 3 pi in courses of at most 2 pi / 3, evenly timed, all reporting goal 0
+    # a smooth split: 3 pi in 24 courses of about pi / 8, evenly timed, all reporting goal 0
     assert [(c.t_start, c.t_end, c.index) for c in plan.courses] == [
-        (0.0, 0.4, 0), (0.4, 0.8, 0), (0.8, 1.2, 0), (1.2, 1.6, 0), (1.6, 2.0, 0),
-    ]  # fmt: skip
+        (2.0 * i / 24, 2.0 * (i + 1) / 24, 0) for i in range(24)
+    ]
     assert len(plan.goal_orientations()) == 1
     t = np.linspace(0.0, 2.0, 4001)
     w_axis = np.array([plan.sample(x).angular_velocity @ axis for x in t])
@@ -320,7 +320,8 @@ def test_random_rod_plans_are_exact_and_continuous(pos_spec, ori_spec, initial):
 
 def test_somersault_on_the_control_grid_splits_as_the_env_does():
     """plan_body and the env's tracks share one splitter: on a control grid the sub-courses
-    end on the same ticks (2.05 s at 60 Hz is 123 ticks, not divisible into 5 courses)."""
+    end on the same ticks (2.05 s at 60 Hz is 123 ticks, not divisible into the smooth
+    split's 24 courses); the sub-rotations too."""
     from sgc_env.envs.tracks import compile_tracks
     from sgc_env.scenario import Body, Goal, Scenario, resolve_scenario
 
@@ -334,7 +335,10 @@ def test_somersault_on_the_control_grid_splits_as_the_env_does():
     )  # fmt: skip
     ends = [c.t_end for c in plan.courses]
     assert ends == tracks[0].orientation.times.tolist()
-    assert [round(t * 60) for t in ends] == [25, 49, 74, 98, 123]
+    assert [round(t * 60) for t in ends] == [round(i * 123 / 24) for i in range(1, 25)]
+    pieces = np.linalg.norm(tracks[0].orientation.course_start, axis=1)
+    assert pieces.sum() == pytest.approx(3 * math.pi, abs=1e-12)
+    assert pieces.max() > 2 * pieces.min()  # unequal: from rest up to the average pace
     even = plan_body(_state(), [], [OrientationGoal(2.05, relative_rotation=rel)])
     assert [c.t_end for c in even.courses] != ends  # continuous time: 0.41, 0.82, ...
 

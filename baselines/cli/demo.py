@@ -195,6 +195,13 @@ def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trai
     return [Trail(recent[:, b], stamps) for b in range(recent.shape[1])]
 
 
+_SMOOTHNESS_KEYS = (
+    "ldlj_track", "acceleration_peak", "acceleration_kink",
+    "angular_ldlj_track", "angular_acceleration_peak", "angular_acceleration_kink",
+)  # fmt: skip
+"""The harness's whole-track smoothness figures each rod's row carries (docs/metrics.md)."""
+
+
 def _per_rod(
     record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any
 ) -> list[dict[str, Any]]:
@@ -217,6 +224,7 @@ def _per_rod(
                 "sparc_track": card.get("sparc_track"),
                 "goal_speed_ratio_min": card.get("goal_speed_ratio_min"),
                 "speed_minima": card.get("speed_minima_total"),
+                **{key: card.get(key) for key in _SMOOTHNESS_KEYS},
                 "goals_met": card.get("goals_met"),
             }
         )

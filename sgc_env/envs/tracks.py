@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.orientation import split_rotation
+from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
 from sgc_env.scenario import Body, Scenario
 
 __all__ = ["BodyTracks", "Track", "compile_tracks"]
@@ -85,12 +85,20 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
     goal_ids, quats, starts, times, via = [], [], [], [], []
     prev_q = tuple(body.orientation)
     prev_t = 0.0
-    for j in ids:
+    goals = [body.goals[j] for j in ids]
+    paces = neighbour_paces(
+        goal_rotations(prev_q, [(g.orientation, g.relative_rotation) for g in goals]),
+        [float(g.time) for g in goals],  # type: ignore[arg-type]
+        body.angular_velocity, body.end_angular_velocity,
+    )  # fmt: skip
+    for j, (rate_in, rate_out) in zip(ids, paces, strict=True):
         g = body.goals[j]
         t = float(g.time)  # type: ignore[arg-type]
         if g.relative_rotation is not None:
             rel = tuple(float(x) for x in g.relative_rotation)
-            split = split_rotation(rel, prev_t, t, freq, f"{body.name}.goals[{j}]")
+            split = split_rotation(
+                rel, prev_t, t, freq, f"{body.name}.goals[{j}]", rate_in=rate_in, rate_out=rate_out
+            )
             pieces = [(step, end, k == len(split) - 1) for k, (step, end) in enumerate(split)]
         else:
             q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]

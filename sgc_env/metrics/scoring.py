@@ -246,6 +246,9 @@ def _rotation_courses(
                 "duration": duration,
                 "samples": int(idx.size),
                 "angular_sparc": sg.sparc(omega[idx], fs, fc=fc) if moving else math.nan,
+                "angular_ldlj": (
+                    sg.ldlj(traj.body_angular_velocity[idx], traj.dt) if moving else math.nan
+                ),
                 "angle_travelled": travelled,
                 "angle_needed": needed,
                 "rotation_ratio": sg.rotation_ratio(travelled, needed, tol.orientation),
@@ -276,6 +279,30 @@ def _track_smoothness(
     if idx.size < MIN_COURSE_SAMPLES or float(speed.max(initial=0.0)) <= STILL_SPEED:
         return {"sparc_track": math.nan, "sparc_track_cutoff_hz": fc}
     return {"sparc_track": sg.sparc(speed, fs, fc=fc), "sparc_track_cutoff_hz": fc}
+
+
+def _track_kinematics(
+    traj: BodyTrajectory,
+    velocity: np.ndarray,
+    goals: Sequence[GoalSpec],
+    start_time: float,
+    prefix: str,
+) -> dict[str, float]:
+    """LDLJ, peak acceleration and the largest one-tick change of acceleration over a track.
+
+    Every tick from ``start_time`` to the track's last goal counts, so kinks at goals and at
+    boundaries no goal marks (a split somersault's sub-courses) are all seen. nan without
+    goals, movement or enough samples.
+    """
+    keys = (f"{prefix}ldlj_track", f"{prefix}acceleration_peak", f"{prefix}acceleration_kink")
+    if not goals:
+        return dict.fromkeys(keys, math.nan)
+    idx = sg.in_window(traj.times, start_time, goals[-1].time)
+    v = velocity[idx]
+    if idx.size < MIN_COURSE_SAMPLES or float(np.linalg.norm(v, axis=1).max()) <= STILL_SPEED:
+        return dict.fromkeys(keys, math.nan)
+    peak, kink = sg.acceleration_peak_and_kink(v, traj.dt)
+    return dict(zip(keys, (sg.ldlj(v, traj.dt), peak, kink), strict=True))
 
 
 def _effort(traj: BodyTrajectory) -> dict[str, float]:
@@ -358,7 +385,18 @@ def score_body(
     card["angular_sparc_mean"] = sg.safe_mean(_column(rot_courses, "angular_sparc"))
     card["rotation_ratio_max"] = sg.safe_max(_column(rot_courses, "rotation_ratio"))
     card["rotation_excess_total"] = float(np.sum(_column(rot_courses, "rotation_excess")))
+    card["angular_ldlj_mean"] = sg.safe_mean(_column(rot_courses, "angular_ldlj"))
     card.update(_track_smoothness(trajectory, pos_goals, start_time, sparc_cycles))
+    point_velocity = (
+        trajectory.tracked_point(pos_goals[-1].point)[1] if pos_goals else trajectory.body_velocity
+    )
+    card.update(_track_kinematics(trajectory, point_velocity, pos_goals, start_time, ""))
+    card.update(
+        _track_kinematics(
+            trajectory, trajectory.body_angular_velocity, ori_goals or goals, start_time,
+            "angular_",
+        )
+    )  # fmt: skip
     card.update(_effort(trajectory))
     return card
 
@@ -373,6 +411,10 @@ _EPISODE_MAX_KEYS = (
     "velocity_jump_max",
     "angular_velocity_jump_max",
     "rotation_ratio_max",
+    "acceleration_peak",
+    "acceleration_kink",
+    "angular_acceleration_peak",
+    "angular_acceleration_kink",
     "force_peak",
     "torque_peak",
 )
@@ -426,5 +468,8 @@ def score_episode(
     for key, rows in (("sparc", pos_courses), ("ldlj", pos_courses)):
         summary[f"{key}_mean"] = sg.safe_mean(_column(rows, key))
     summary["angular_sparc_mean"] = sg.safe_mean(_column(rot_courses, "angular_sparc"))
+    summary["angular_ldlj_mean"] = sg.safe_mean(_column(rot_courses, "angular_ldlj"))
+    for key in ("ldlj_track", "angular_ldlj_track"):
+        summary[f"{key}_mean"] = sg.safe_mean([c[key] for c in cards])
     summary["sparc_track_mean"] = sg.safe_mean([c["sparc_track"] for c in cards])
     return summary

@@ -266,12 +266,13 @@ def speed_minima(speed: ArrayLike, min_prominence: float) -> FloatArray:
 
 
 def velocity_jump(times: ArrayLike, velocity: ArrayLike, t: float) -> float:
-    """|v(t+) - v(t-)| from per-step velocities, for an event at time `t`.
+    """Largest one-tick change of velocity at an event at time `t`: into it and out of it.
 
     Sample k holds the velocity over the step (t_{k-1}, t_k] (semi-implicit Euler), so for an
-    event on or after tick k and before tick k+1 the jump is |v_{k+1} - v_k|. An event off the
-    ticks still reports the change across the step that contains it. Returns nan if there is
-    no sample on one side.
+    event on or after tick k and before tick k+1 the step out of it changes the velocity by
+    |v_{k+1} - v_k| and the step into it by |v_k - v_{k-1}|; the larger is returned. A
+    controller can hide a kink in the last tick before a goal (a ramp) as well as in the first
+    one after it, so both count. Returns nan if there is no sample after the event.
     """
     ts = check_times(times)
     v = as_finite_array(velocity, "velocity")
@@ -279,7 +280,42 @@ def velocity_jump(times: ArrayLike, velocity: ArrayLike, t: float) -> float:
     k, _ = locate(ts, t)
     if k < 0 or k + 1 >= ts.size:
         return math.nan
-    return float(np.linalg.norm(np.atleast_1d(v[k + 1] - v[k])))
+    jump = float(np.linalg.norm(np.atleast_1d(v[k + 1] - v[k])))
+    if k >= 1:
+        jump = max(jump, float(np.linalg.norm(np.atleast_1d(v[k] - v[k - 1]))))
+    return jump
+
+
+def accelerations(velocity: ArrayLike, dt: float) -> FloatArray:
+    """Per-step accelerations (v_k - v_{k-1}) / dt, shape (n - 1, ...) for n velocity samples.
+
+    With semi-implicit Euler this is exactly the acceleration applied in step k.
+    """
+    v = as_finite_array(velocity, "velocity")
+    _check_positive(dt, "dt")
+    if v.shape[0] < 2:
+        raise ValueError("velocity must have at least 2 samples")
+    return np.diff(v, axis=0) / dt
+
+
+def acceleration_peak_and_kink(velocity: ArrayLike, dt: float) -> tuple[float, float]:
+    """Peak |a| and the largest one-tick change of acceleration |a_{k+1} - a_k| (the "kink").
+
+    Over every tick of the signal, so a jump of acceleration at a goal or at a boundary that
+    no goal marks (a split somersault's sub-course) is seen wherever it is. Units: those of
+    the velocity per second (the kink is the change within one tick, not divided by dt, so it
+    compares methods at the same dt). nan where there are too few samples.
+    """
+    v = as_finite_array(velocity, "velocity")
+    if v.ndim == 1:
+        v = v[:, None]
+    if v.shape[0] < 2:
+        return math.nan, math.nan
+    a = accelerations(v, dt)
+    peak = float(np.max(np.linalg.norm(a, axis=1)))
+    if a.shape[0] < 2:
+        return peak, math.nan
+    return peak, float(np.max(np.linalg.norm(np.diff(a, axis=0), axis=1)))
 
 
 def step_weights(times: ArrayLike, dt: float, t_start: float, t_end: float) -> FloatArray:

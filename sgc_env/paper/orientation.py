@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -26,8 +27,12 @@ from sgc_env.paper import quaternion
 __all__ = [
     "MAX_COURSE_ROTATION",
     "MAX_RELATIVE_ROTATION",
+    "SMOOTH_PIECE_ANGLE",
     "angular_acceleration",
     "course_pieces",
+    "goal_rotations",
+    "neighbour_paces",
+    "rotation_profile",
     "angular_velocity",
     "left_jacobian",
     "left_jacobian_inverse",
@@ -39,6 +44,7 @@ __all__ = [
 ]
 
 _TWO_PI = 2.0 * math.pi
+Vector = Sequence[float] | np.ndarray
 
 MAX_COURSE_ROTATION = 2.0 * math.pi / 3.0
 """Longest rotation one orientation course may make; longer relative rotations are split.
@@ -65,16 +71,63 @@ def course_pieces(rotation_vector: ArrayLike) -> int:
     return max(1, math.ceil(angle / MAX_COURSE_ROTATION - 1e-12))
 
 
+SMOOTH_PIECE_ANGLE = math.pi / 8.0
+"""Target rotation of one sub-course of a smooth split (:func:`split_rotation` with paces):
+short enough that the sub-courses' average rates follow the rate profile closely."""
+
+_MAX_PIECES = math.ceil(MAX_RELATIVE_ROTATION / MAX_COURSE_ROTATION)
+
+SMOOTH_PIECE_TICKS = 4
+"""Fewest control ticks per sub-course of a smooth split (fewer pieces when time is short)."""
+
+
+PACE_FLOOR = 0.25
+"""Smallest pace of a smooth split's ends, as a share of its mean rate (rotation_profile)."""
+
+
+def rotation_profile(
+    s: float | np.ndarray, rate_in: float, rate_out: float, mean: float
+) -> float | np.ndarray:
+    """Fraction of a split rotation done at normalised time ``s`` in [0, 1] (1 at ``s = 1``).
+
+    The rate ``r(s) = rate_in (1 - h) + rate_out h + c h'`` with ``h`` the minimum-jerk step
+    ``10 s^3 - 15 s^4 + 6 s^5``: it starts at ``rate_in``, ends at ``rate_out``, has zero
+    slope (angular acceleration) at both ends and its bump ``c h'`` makes the mean ``mean``.
+    ``rate_in`` and ``rate_out`` are clamped to ``[mean / 4, 2 mean]``, which keeps the rate
+    above ``mean / 8`` (no stop, no turning back) and at most ``2 mean``. The floor keeps the
+    first and last pieces from shrinking to nothing (a spin from rest, or to a dwell): a piece
+    of almost no angle entered at speed would have to brake violently within it.
+    """
+    w0 = min(max(rate_in, PACE_FLOOR * mean), 2.0 * mean)
+    w1 = min(max(rate_out, PACE_FLOOR * mean), 2.0 * mean)
+    c = mean - 0.5 * (w0 + w1)
+    s2 = s * s
+    h = s2 * s * (10.0 - 15.0 * s + 6.0 * s2)
+    big_h = s2 * s2 * (2.5 - 3.0 * s + s2)
+    return (w0 * s + (w1 - w0) * big_h + c * h) / mean
+
+
 def split_rotation(
     rotation_vector: Sequence[float] | np.ndarray,
     t0: float,
     t1: float,
     control_frequency: int | None = None,
     where: str = "relative rotation",
+    *,
+    rate_in: float | None = None,
+    rate_out: float | None = None,
 ) -> list[tuple[tuple[float, float, float], float]]:
-    """A relative rotation from ``t0`` to ``t1`` as :func:`course_pieces` equal sub-rotations
-    about its axis: ``(sub-rotation vector, end time)`` per course (the one splitter of the
-    env's tracks and :func:`sgc_env.paper.plan.plan_body`).
+    """A relative rotation from ``t0`` to ``t1`` as sub-rotations about its axis:
+    ``(sub-rotation vector, end time)`` per course (the one splitter of the env's tracks and
+    :func:`sgc_env.paper.plan.plan_body`).
+
+    Without paces: :func:`course_pieces` equal sub-rotations (the constant rate of the
+    original split). With ``rate_in`` and ``rate_out`` (rad/s along the axis: the paces of
+    the neighbouring orientation courses, see :func:`neighbour_paces`) a *smooth split*: about
+    one piece per :data:`SMOOTH_PIECE_ANGLE`, at least :data:`SMOOTH_PIECE_TICKS` ticks each,
+    sub-rotations unequal so that their average rates follow :func:`rotation_profile` from
+    the incoming to the outgoing pace. The pace change is then spread over the pieces instead
+    of one sub-course's sharp acceleration (docs/smoothness.md).
 
     With ``control_frequency`` the courses are timed as the env times them, on its control
     grid: course ``i`` of ``m`` ends on tick ``k0 + round(i (k1 - k0) / m)`` with ``k0, k1``
@@ -86,19 +139,108 @@ def split_rotation(
         m = course_pieces(rel)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
-    step = (rel[0] / m, rel[1] / m, rel[2] / m)
-    if control_frequency is None:
-        return [(step, t1 if i == m else t0 + (t1 - t0) * i / m) for i in range(1, m + 1)]
+    angle = math.sqrt(sum(c * c for c in rel))
     f = control_frequency
-    k0, k1 = round(t0 * f), round(t1 * f)
-    if k1 - k0 < m:
-        angle = math.sqrt(sum(c * c for c in rel))
+    k0, k1 = (round(t0 * f), round(t1 * f)) if f is not None else (0, 0)
+    if f is not None and k1 - k0 < m:
         raise ValueError(
             f"{where}: a relative rotation of {angle:.6g} rad is split into {m} courses of at "
             f"most {MAX_COURSE_ROTATION:.4g} rad, which needs {m} control ticks before the goal "
             f"time but only {k1 - k0} are left; give the goal more time"
         )
-    return [(step, (k0 + round(i * (k1 - k0) / m)) / f) for i in range(1, m + 1)]
+    smooth = rate_in is not None and rate_out is not None and m > 1
+    if smooth:
+        # no more courses than the longest equal split (96): bounds the planner's work
+        wanted = min(math.ceil(angle / SMOOTH_PIECE_ANGLE - 1e-12), _MAX_PIECES)
+        m = max(m, min(wanted, (k1 - k0) // SMOOTH_PIECE_TICKS) if f is not None else wanted)
+    if f is None:
+        ends = [t1 if i == m else t0 + (t1 - t0) * i / m for i in range(1, m + 1)]
+        fractions = [i / m for i in range(m + 1)]
+    else:
+        ticks = [k0 + round(i * (k1 - k0) / m) for i in range(m + 1)]
+        ends = [k / f for k in ticks[1:]]
+        fractions = [(k - k0) / (k1 - k0) for k in ticks]
+    if not smooth:
+        step = (rel[0] / m, rel[1] / m, rel[2] / m)
+        return [(step, end) for end in ends]
+    mean = angle / (t1 - t0)
+    done = [
+        float(rotation_profile(s, cast(float, rate_in), cast(float, rate_out), mean))
+        for s in fractions
+    ]
+    done[-1] = 1.0
+    if max(b - a for a, b in zip(done[:-1], done[1:], strict=True)) * angle > (
+        MAX_COURSE_ROTATION
+    ):  # too few ticks for the profile's bulge: the constant rate still fits
+        return split_rotation(rel, t0, t1, control_frequency, where)
+    return [
+        ((rel[0] * (b - a), rel[1] * (b - a), rel[2] * (b - a)), end)
+        for a, b, end in zip(done[:-1], done[1:], ends, strict=True)
+    ]
+
+
+def neighbour_paces(
+    rotations: Sequence[Sequence[float]],
+    times: Sequence[float],
+    angular_velocity: Sequence[float] | np.ndarray,
+    end_angular_velocity: Sequence[float] | np.ndarray | None,
+) -> list[tuple[float, float]]:
+    """``(rate_in, rate_out)`` per goal of an orientation track, for :func:`split_rotation`.
+
+    ``rotations``: each goal's rotation from the previous one (a rotation vector, longer than
+    pi for a somersault), ``times`` the goals' times (the track starts at 0). The paces are
+    the average rates (angle / duration) of the courses before and after the goal; before the
+    first, the initial angular velocity along the first rotation's axis; after the last, the
+    end angular velocity along its axis (None: the last course's own average). Env and
+    planner both call this, so they split a somersault alike.
+    """
+    angles = [math.sqrt(sum(float(c) * float(c) for c in r)) for r in rotations]
+    durations = np.diff(np.concatenate(([0.0], np.asarray(times, float)))).tolist()
+    rates = [a / d for a, d in zip(angles, durations, strict=True)]
+    out = []
+    for j, rate in enumerate(rates):
+        before = _axis_rate(rotations[0], angular_velocity) if j == 0 else rates[j - 1]
+        if j + 1 < len(rates):
+            after = rates[j + 1]
+        elif end_angular_velocity is None:
+            after = rate
+        else:
+            after = _axis_rate(rotations[j], end_angular_velocity)
+        out.append((before, after))
+    return out
+
+
+def goal_rotations(
+    start: Sequence[float],
+    goals: Sequence[tuple[Vector | None, Vector | None]],
+) -> list[tuple[float, float, float]]:
+    """Each orientation goal's rotation from the previous one (a rotation vector), from the
+    start quaternion (xyzw) and ``(orientation, relative_rotation)`` per goal, exactly one of
+    them given: the relative rotation itself, or the principal rotation to the orientation.
+    The input of :func:`neighbour_paces`."""
+    out = []
+    q = tuple(float(c) for c in start)
+    for orientation, relative in goals:
+        if relative is not None:
+            r = (float(relative[0]), float(relative[1]), float(relative[2]))
+            q = quaternion.mul(quaternion.exp_normalized(r), q)
+        else:
+            target = tuple(float(c) for c in cast(Sequence[float], orientation))
+            r = quaternion.log(quaternion.mul_conjugate(target, q))
+            q = target
+        out.append(r)
+    return out
+
+
+def _axis_rate(
+    rotation_vector: Sequence[float], angular_velocity: Sequence[float] | np.ndarray
+) -> float:
+    """Component of an angular velocity along a rotation's axis (0 for a zero rotation)."""
+    angle = math.sqrt(sum(float(c) * float(c) for c in rotation_vector))
+    if angle == 0.0:
+        return 0.0
+    dot = sum(float(a) * float(w) for a, w in zip(rotation_vector, angular_velocity, strict=True))
+    return dot / angle
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

@@ -46,8 +46,10 @@ from sgc_env.paper.frames import (
 from sgc_env.paper.frames import solve_course_in_frame as _solve_in_frame
 from sgc_env.paper.orientation import (
     angular_acceleration,
+    goal_rotations,
     left_jacobian,
     left_jacobian_inverse_apply,
+    neighbour_paces,
     split_rotation,
 )
 
@@ -314,6 +316,7 @@ def _orientation_courses(
     goals: Sequence[OrientationGoal],
     times: Sequence[float],
     control_frequency: int | None = None,
+    rates: tuple[np.ndarray, np.ndarray | None] = (np.zeros(3), None),
 ) -> tuple[list[tuple[Rotation, np.ndarray, float, int]], list[Rotation]]:
     """(goal rotation, phi at the course start, end time, goal index) per course, and the
     rotation each goal reaches.
@@ -321,10 +324,23 @@ def _orientation_courses(
     A relative rotation longer than ``MAX_COURSE_ROTATION`` becomes equal sub-rotations about
     its axis (:func:`~sgc_env.paper.orientation.split_rotation`, the env's splitter): a course
     starting on ``|phi| = 2 pi`` could not carry the angular velocity across its axis. With a
-    ``control_frequency`` the sub-courses end on the env's ticks.
+    ``control_frequency`` the sub-courses end on the env's ticks. ``rates``: the initial and
+    the end angular velocity, which set the paces of a smooth split
+    (:func:`~sgc_env.paper.orientation.neighbour_paces`, as the env).
     """
     out, reached = [], []
     prev, t_prev = r0, 0.0
+    checked: list[tuple[np.ndarray | None, np.ndarray | None]] = []
+    for i, g in enumerate(goals):
+        where = f"orientation goal {i}"
+        if (g.orientation is None) == (g.relative_rotation is None):
+            raise ValueError(f"{where}: give exactly one of orientation and relative_rotation")
+        if g.relative_rotation is None:
+            quat = _quat(cast(np.ndarray, g.orientation), where, "orientation").as_quat()
+            checked.append((quat, None))
+        else:
+            checked.append((None, _vec(g.relative_rotation, 3, where, "relative_rotation")))
+    paces = neighbour_paces(goal_rotations(r0.as_quat(), checked), times, rates[0], rates[1])
     for i, g in enumerate(goals):
         where = f"orientation goal {i}"
         if (g.orientation is None) == (g.relative_rotation is None):
@@ -335,7 +351,10 @@ def _orientation_courses(
             prev = goal
         else:
             rel = _vec(g.relative_rotation, 3, where, "relative_rotation")
-            for step, end in split_rotation(rel, t_prev, times[i], control_frequency, where):
+            rate_in, rate_out = paces[i]
+            for step, end in split_rotation(
+                rel, t_prev, times[i], control_frequency, where, rate_in=rate_in, rate_out=rate_out
+            ):
                 prev = Rotation.from_rotvec(step) * prev
                 out.append((prev, -np.array(step), end, i))
         reached.append(prev)
@@ -352,7 +371,7 @@ def _plan_orientation(
     opts: PlanOptions,
     diags: list[CourseDiagnostics],
 ) -> tuple[list[Rotation], list[Rotation], _Track]:
-    pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency)
+    pieces, reached = _orientation_courses(r0, goals, times, opts.control_frequency, (w0, end_w))
     starts = [phi0 for _, phi0, _, _ in pieces]
     ends = [end for _, _, end, _ in pieces]
     courses: list[Any] = []

@@ -69,14 +69,16 @@ def run(args: argparse.Namespace) -> int:
     table = Table(title=f"three-rod demo: the expert ({rule}), scored by the harness")
     table.add_column("rod", no_wrap=True)
     for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
-                   "SPARC", "min speed at goals / avg"):  # fmt: skip
+                   "SPARC", "min speed at goals / avg", "kink (m/s²)",
+                   "ang kink (rad/s²)"):  # fmt: skip
         table.add_column(column, justify="right")
     for rod in result.per_rod:
         table.add_row(
             rod["rod"], str(rod["goals"]), str(rod["goals_met"]),
             f"{rod['position_error_max_m']:.1e}", _fmt(rod["orientation_error_max_rad"]),
             _fmt(rod["closest_approach_offset_max_s"]), _fmt(rod["sparc_track"], ".2f"),
-            _fmt(rod["goal_speed_ratio_min"], ".2f"),
+            _fmt(rod["goal_speed_ratio_min"], ".2f"), _fmt(rod["acceleration_kink"], ".1f"),
+            _fmt(rod["angular_acceleration_kink"], ".1f"),
         )  # fmt: skip
     console.print(table)
     summary = result.summary

@@ -29,7 +29,15 @@ from baselines.cli.checks import (
 )
 from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
 
-__all__ = ["SCORECARD_COLUMNS", "add_arguments", "expand_envs", "markdown_table", "run"]
+__all__ = [
+    "SCORECARD_COLUMNS",
+    "SMOOTHNESS_COLUMNS",
+    "SMOOTHNESS_WIDE_COLUMNS",
+    "add_arguments",
+    "expand_envs",
+    "markdown_table",
+    "run",
+]
 
 #: (summary key, column title, format) of the comparison table.
 SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
@@ -44,6 +52,8 @@ SCORECARD_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("speed_minima_mean", "speed minima / ep", ".1f"),
     ("goal_speed_ratio_min", "goal speed ratio min", ".3f"),
     ("velocity_jump_max", "vel jump max (m/s)", ".3f"),
+    ("acceleration_kink_max", "kink (m/s²)", ".2f"),
+    ("angular_acceleration_kink_max", "ang kink (rad/s²)", ".2f"),
     ("force_peak_max", "peak force (N)", ".1f"),
     ("force_sq_integral_mean", "force² ∫ (N² s)", ".0f"),
     ("terminated", "terminated", "d"),
@@ -58,6 +68,26 @@ COMPACT_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("position_error_max", "pos err\nmax (m)", ".1e"),
     ("orientation_error_max", "ori err\nmax (rad)", ".1e"),
     ("position_closest_offset_abs_max", "offset\nmax (s)", ".3f"),
+)
+
+#: The smoothness table printed under the compact one: LDLJ over the whole track and the
+#: largest one-tick change of acceleration (the kink), linear and angular (peaks: ``--wide``).
+SMOOTHNESS_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("ldlj_track_mean", "LDLJ\ntrack", ".2f"),
+    ("acceleration_kink_max", "kink\n(m/s²)", ".2f"),
+    ("angular_ldlj_track_mean", "ang LDLJ\ntrack", ".2f"),
+    ("angular_acceleration_kink_max", "ang kink\n(rad/s²)", ".2f"),
+)
+
+#: The smoothness table with ``--wide``: peaks and the angular velocity jump too.
+SMOOTHNESS_WIDE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    *SMOOTHNESS_COLUMNS[:4],
+    ("acceleration_peak_max", "peak acc\n(m/s²)", ".1f"),
+    *SMOOTHNESS_COLUMNS[4:],
+    ("angular_acceleration_peak_max", "peak ang acc\n(rad/s²)", ".1f"),
+    ("angular_velocity_jump_max", "ang vel jump\nmax (rad/s)", ".3f"),
 )
 
 #: Per-goal table of a single pair: (row key, full title, compact title, format).
@@ -171,9 +201,15 @@ def _table(title: str, wide: bool) -> Any:
     return Table(title=title, box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
 
 
-def _rich_table(summaries: Sequence[Mapping[str, Any]], title: str, wide: bool = False) -> Any:
+def _rich_table(
+    summaries: Sequence[Mapping[str, Any]],
+    title: str,
+    wide: bool = False,
+    columns: Sequence[tuple[str, str, str]] | None = None,
+) -> Any:
     table = _table(title, wide)
-    columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
+    if columns is None:
+        columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
     for _, name, fmt in columns:
         text = fmt == "s"
         table.add_column(name, justify="left" if text else "right", overflow="fold")
@@ -270,6 +306,9 @@ def run(args: argparse.Namespace) -> int:
             (stage / "scorecard.md").write_text(markdown_table(summaries))
     title = f"{args.episodes} episode(s) from seed {args.seed}"
     console.print(_rich_table(summaries, title, args.wide))
+    smooth_title = "smoothness: LDLJ over the track, one-tick change of acceleration (kink)"
+    smooth = SMOOTHNESS_WIDE_COLUMNS if args.wide else SMOOTHNESS_COLUMNS
+    console.print(_rich_table(summaries, smooth_title, args.wide, columns=smooth))
     console.print(f"[dim]wrote {root}[/dim]")
     console.print(summary_line(summaries[0]) if single else _goals_met_line(summaries))
     return 0

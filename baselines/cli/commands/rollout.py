@@ -13,6 +13,7 @@ side by side. ``--video`` adds ``rollout.mp4`` (TinyRenderer frames via imageio)
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -124,5 +125,23 @@ def run(args: argparse.Namespace) -> int:
         f"position error max {card['position_error_max']:.2e} m, "
         f"orientation error max {card['orientation_error_max']:.2e} rad"
     )
+    console.print(smoothness_line(card))
     console.print(f"[dim]wrote {out}[/dim]")
     return 0
+
+
+def smoothness_line(card: dict[str, Any]) -> str:
+    """The episode's smoothness, linear and angular: LDLJ over the track (mean over bodies),
+    peak acceleration and the largest one-tick change of acceleration (the largest over
+    bodies; docs/metrics.md)."""
+    parts = []
+    for prefix, unit, name in (("", "m/s²", "linear"), ("angular_", "rad/s²", "angular")):
+        values = [card[f"{prefix}{k}"] for k in
+                  ("ldlj_track_mean", "acceleration_peak", "acceleration_kink")]  # fmt: skip
+        if all(isinstance(v, float) and math.isnan(v) for v in values):
+            continue
+        parts.append(
+            f"{name}: LDLJ track {values[0]:.2f}, peak acceleration {values[1]:.3g} {unit}, "
+            f"largest one-tick change of acceleration {values[2]:.3g} {unit}"
+        )
+    return "; ".join(parts) if parts else "no movement to score for smoothness"
