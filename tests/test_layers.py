@@ -116,7 +116,6 @@ KNOWN_CIRCLES: set[frozenset[str]] = {
 
 KNOWN_LONG_MODULES = {
     "sgc_env/envs/sgc_env.py",  # split on branch vec (actuation out of step and _commit)
-    "sgc_env/paper/course.py",  # shrunk on branch smooth
 }
 MAX_LINES = 600
 MAX_LOOSE_MODULES = 8
