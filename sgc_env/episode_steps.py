@@ -25,7 +25,13 @@ from sgc_env.random_three_rods import RandomThreeRodsConfig
 from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
 from sgc_env.three_rods import EMBED_DURATION, ROD_SPECS
 
-__all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
+__all__ = [
+    "EpisodeLengthCheck",
+    "check_episode_length",
+    "random_steps_bound",
+    "registered_steps",
+    "scenario_steps",
+]
 
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
@@ -86,6 +92,22 @@ def _builtin(name: str) -> Scenario:
     return scenario_from_dict(yaml.load(text, Loader=_LOADER), name=name)
 
 
+def check_episode_length(
+    env_id: str, limit: int | None, needed: int, remedy: str = "to gym.make or gym.make_vec"
+) -> None:
+    """A ValueError when the registry's own TimeLimit of ``env_id`` (``limit``, the steps an
+    episode may last) would end an episode of ``needed`` steps early; a limit the caller chose
+    (any other value) is left alone. ``remedy`` ends the message (where to pass a limit)."""
+    if limit is None or needed <= limit or env_id not in gym.registry:
+        return
+    if limit == gym.spec(env_id).max_episode_steps:
+        raise ValueError(
+            f"{env_id}: this episode lasts {needed} steps but the registered TimeLimit ends "
+            f"episodes after {limit}; pass max_episode_steps={needed} (or -1 for no TimeLimit) "
+            f"{remedy}"
+        )
+
+
 class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Refuses, at reset, an episode that the registered ``TimeLimit`` would end too early.
 
@@ -101,13 +123,6 @@ class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
         result = self.env.reset(**kwargs)
         spec, base = self.env.spec, self.env.unwrapped
         limit = None if spec is None else spec.max_episode_steps
-        needed = int(getattr(base, "max_steps", 0))
-        if limit is not None and needed > limit and base.spec is not None:
-            registered = gym.spec(base.spec.id).max_episode_steps
-            if limit == registered:
-                raise ValueError(
-                    f"{base.spec.id}: this episode lasts {needed} steps but the registered "
-                    f"TimeLimit ends episodes after {limit}; pass max_episode_steps={needed} "
-                    "(or -1 for no TimeLimit) to gym.make"
-                )
+        if base.spec is not None:
+            check_episode_length(base.spec.id, limit, int(getattr(base, "max_steps", 0)))
         return result

@@ -106,7 +106,6 @@ plain reset).
 
 from __future__ import annotations
 
-import math
 import struct
 import weakref
 from collections.abc import Sequence
@@ -117,18 +116,19 @@ from typing import Any, TypedDict, cast
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.episode_steps import scenario_steps
+from sgc_env.episode_steps import check_episode_length, scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
 from sgc_env.rendering import CameraConfig, NailMarkers, available_render_modes
 from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
 from sgc_env.simulator import Drive, Simulator
 
+from .actuation import Actuation, clip_action
 from .props import PropPaths
 from .rewards import make_reward
 from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
+from .world import SharedWorld
 
 __all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
@@ -247,6 +247,7 @@ class SGCEnv(gym.Env):
         render_mode: str | None = None,
         camera: dict[str, Any] | None = None,
         reward: str = "schedule",
+        world: SharedWorld | None = None,
     ) -> None:
         self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
@@ -289,8 +290,6 @@ class SGCEnv(gym.Env):
             )
         self.control_frequency = cf
         self.substeps = self.sim_frequency // cf
-        h = 1.0 / self.sim_frequency
-        self._substep_coef = [(k * h, h * h * k * (k + 1) / 2) for k in range(self.substeps)]
         self.dt = 1.0 / cf
         # "human" is offered only where a display exists, so headless checkers do not open a GUI.
         self.metadata = {
@@ -319,8 +318,17 @@ class SGCEnv(gym.Env):
         self._geometry: tuple = ()
         # Everything that can reject the scenario runs before the PyBullet client exists; if
         # building the scene still fails, the client is closed before the error propagates.
+        self._world = world
+        if world is not None:
+            if render_mode is not None:
+                raise ValueError("render_mode: a sub-env of a batched env does not render")
+            world.check_frequency(self.sim_frequency)
         prepared = self._prepare(base)
-        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        self.sim = (
+            Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+            if world is None
+            else world.view()
+        )
         try:
             self._build(base)
             self._commit(prepared)
@@ -352,6 +360,9 @@ class SGCEnv(gym.Env):
             self.sim.add_body(
                 p.name, p.shape, p.size, 0.0, p.color, kinematic=True, collisions=p.collisions
             )
+        self.sim.built(
+            [(b.name, b.collisions) for b in s.bodies] + [(p.name, p.collisions) for p in s.props]
+        )
         self._uids = [self.sim.bodies[b.name].uid for b in s.bodies]
         self._prop_uids = [self.sim.bodies[p.name].uid for p in s.props]
         self.body_inertia = np.array([self.sim.inertia_diagonal(b.name) for b in s.bodies])
@@ -378,6 +389,8 @@ class SGCEnv(gym.Env):
                 f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
                 f"{self.control_frequency} Hz"
             )
+        if self._world is not None:
+            self._world.check_gravity(s.gravity)
         max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
         return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
@@ -395,17 +408,15 @@ class SGCEnv(gym.Env):
                 raise
         self.scenario = s
         self.sim.set_gravity(s.gravity)
-        self._gravity = tuple(float(g) for g in s.gravity)
         self.task = prepared.task
         self.max_steps = prepared.max_steps
         self._props = prepared.props
         self._mass = [b.mass for b in s.bodies]
-        self._flimit = [float(b.force_limit) for b in s.bodies]
-        self.torque_scale = np.array(
-            [float(b.torque_limit) * inertia / inertia.max()
-             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        self._actuation = Actuation(
+            s, self.body_inertia, self._uids, use_torque=self.use_torque,
+            substeps=self.substeps, sim_frequency=self.sim_frequency,
         )  # fmt: skip
-        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
+        self.torque_scale = self._actuation.torque_scale
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
@@ -430,10 +441,28 @@ class SGCEnv(gym.Env):
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
+        self._check_length()
         info = self._info([])
         if self.render_mode == "human":
             self.render()
         return self._obs, info
+
+    def _check_length(self) -> None:
+        """Made by ``gym.make`` from an id without an EpisodeLengthCheck wrapper (one would
+        stop ``gym.make_vec`` from using the batched env): refuse an episode longer than the
+        id's registered TimeLimit, which would cut it short silently. The env cannot see a
+        TimeLimit the caller chose; for longer episodes construct ``SGCEnv`` directly or use
+        ``gym.make_vec(id, ..., max_episode_steps=...)``."""
+        spec = self.spec
+        if spec is None or self._world is not None or spec.id not in gym.registry:
+            return
+        registered = gym.spec(spec.id)
+        if not registered.additional_wrappers:
+            check_episode_length(
+                spec.id, registered.max_episode_steps, self.max_steps,
+                "to gym.make_vec, or construct sgc_env.envs.SGCEnv directly (gym.make's own "
+                "max_episode_steps cannot reach the env)",
+            )  # fmt: skip
 
     def _reset_state(self) -> None:
         for uid, b in zip(self._uids, self.scenario.bodies, strict=True):
@@ -444,8 +473,7 @@ class SGCEnv(gym.Env):
             for uid, pos in zip(self._prop_uids, self._props.at(0), strict=True):
                 self.sim.move(uid, pos)
         self._tick = 0
-        self._zeros3n = [0.0] * (3 * self._n)
-        self._applied = [0.0] * (6 * self._n)
+        self._applied = self._actuation.idle
         self.task.reset()
         self._observe()
 
@@ -511,49 +539,17 @@ class SGCEnv(gym.Env):
     ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         if self._closed:
             self._check_open()
-        a = action if type(action) is np.ndarray else np.asarray(action)
-        if a.dtype.kind not in "fiu":
-            raise TypeError(f"action must hold real numbers, got dtype {a.dtype}: {action!r}")
-        if a.shape != self._action_shape:
-            raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
-        values = a.tolist()
-        hi, lo = max(values), min(values)
-        if hi > 1.0 or lo < -1.0:
-            if hi == math.inf or lo == -math.inf:
-                raise ValueError(f"action contains non-finite values: {values}")
-            values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
-        # Clipped first, so the sum cannot overflow: it is NaN only if an entry is.
-        if math.isnan(sum(values)):
-            raise ValueError(f"action contains non-finite values: {values}")
-        use_torque = self.use_torque
-        per = 6 if use_torque else 3
-        gx, gy, gz = self._gravity
-        coef = self._substep_coef
-        drives: list[Drive] = []
-        applied_f: list[float] = []
-        applied_t: list[float] = []
-        for i, (pos, orn, lin, _) in enumerate(self._states):
-            fl = self._flimit[i]
-            o = i * per
-            fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
-            f = (fx, fy, fz)
-            applied_f += f
-            tq = None
-            if use_torque:
-                sx, sy, sz = self._tscale[i]
-                bx, by, bz = rotate_back(orn, (values[o + 3], values[o + 4], values[o + 5]))
-                tq = rotate(orn, (bx * sx, by * sy, bz * sz))
-                applied_t += tq
-            m = self._mass[i]
-            ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
-            x0, y0, z0 = pos
-            vx, vy, vz = lin
-            # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
-            path = [
-                (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
-                for kh, c in coef
-            ]
-            drives.append((self._uids[i], f, tq, path))
+        values = clip_action(action, self._action_shape)
+        drives, moves = self._drives(values)
+        self.sim.step_bodies(drives, moves)
+        return self._finish_step(values)
+
+    def _drives(
+        self, values: list[float]
+    ) -> tuple[list[Drive], list[list[tuple[int, tuple[float, ...]]]]]:
+        """The bodies' drives and the props' moves (one list per substep) of the next control
+        period; the batched env gathers these from every sub-env into one physics step."""
+        drives, self._applied = self._actuation.drives(values, self._states)
         moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
@@ -562,8 +558,10 @@ class SGCEnv(gym.Env):
                 list(zip(self._prop_uids, at(base + k + 1), strict=True))
                 for k in range(self.substeps)
             ]
-        self.sim.step_bodies(drives, moves)
-        self._applied = applied_f + (applied_t or self._zeros3n)
+        return drives, moves
+
+    def _finish_step(self, values: list[float]) -> tuple[Any, float, bool, bool, StepInfo]:
+        """Everything after the physics of a control step: observe, goal events, reward."""
         self._tick += 1
         self._observe()
         task = self.task
