@@ -89,7 +89,10 @@ class Batch:
     ) -> tuple[Any, dict[str, Any]]:
         """Reset sub-env ``i`` (refusing an episode its time limit would cut short)."""
         env = self.envs[i]
-        obs, info = env.reset(seed=seed, options=options)
+        try:
+            obs, info = env.reset(seed=seed, options=options)
+        except ValueError as err:
+            raise ValueError(f"sub-env {i}: {err}") from err
         if self.env_id is not None:
             check_episode_length(self.env_id, self.limit, env.max_steps)
         self.elapsed[i] = 0
