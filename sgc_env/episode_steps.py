@@ -28,6 +28,7 @@ from sgc_env.three_rods import EMBED_DURATION, ROD_SPECS
 __all__ = [
     "EpisodeLengthCheck",
     "check_episode_length",
+    "check_registered_length",
     "random_steps_bound",
     "registered_steps",
     "scenario_steps",
@@ -106,6 +107,23 @@ def check_episode_length(
             f"episodes after {limit}; pass max_episode_steps={needed} (or -1 for no TimeLimit) "
             f"{remedy}"
         )
+
+
+def check_registered_length(spec: Any, needed: int) -> None:
+    """For an env made by ``gym.make`` (its ``spec``) from an id without an
+    :class:`EpisodeLengthCheck` wrapper (one would stop ``gym.make_vec`` from using the batched
+    env): refuse an episode longer than the id's registered TimeLimit, which would cut it
+    short silently. The env cannot see a TimeLimit the caller chose; longer episodes run on
+    ``SGCEnv`` made directly or through ``gym.make_vec(id, ..., max_episode_steps=...)``."""
+    if spec is None or spec.id not in gym.registry:
+        return
+    registered = gym.spec(spec.id)
+    if not registered.additional_wrappers:
+        check_episode_length(
+            spec.id, registered.max_episode_steps, needed,
+            "to gym.make_vec, or construct sgc_env.envs.SGCEnv directly (gym.make's own "
+            "max_episode_steps cannot reach the env)",
+        )  # fmt: skip
 
 
 class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):

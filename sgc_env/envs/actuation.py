@@ -18,7 +18,7 @@ import numpy as np
 
 from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.scenario import Scenario
-from sgc_env.simulator import BodyState, Drive
+from sgc_env.simulator import BodyState, Drive, Simulator
 
 __all__ = ["Actuation", "clip_action"]
 
@@ -64,6 +64,7 @@ class Actuation:
         self.n_bodies = len(bodies)
         self._uids = list(uids)
         self._mass = [b.mass for b in bodies]
+        self._inertia = inertia
         self._flimit = [float(b.force_limit) for b in bodies]
         self.torque_scale = np.array(
             [float(b.torque_limit) * row / row.max()
@@ -111,3 +112,15 @@ class Actuation:
             ]
             drives.append((self._uids[i], f, tq, path))
         return drives, applied_f + (applied_t or self._zeros3n)
+
+    def impulse(
+        self, i: int, state: BodyState, linear: np.ndarray, angular: np.ndarray
+    ) -> tuple[list[float], list[float]]:
+        """Body ``i``'s velocities after an impulse (N s) and angular impulse (N m s, world
+        frame, about the centre of mass): ``v + p / m``, ``w + R I^-1 R^T L``."""
+        _, orn, lin, ang = state
+        rm = Simulator.rotation_matrix(orn)
+        inverse_inertia = rm @ np.diag(1.0 / self._inertia[i]) @ rm.T
+        new_lin = np.asarray(lin) + linear / self._mass[i]
+        new_ang = np.asarray(ang) + inverse_inertia @ angular
+        return new_lin.tolist(), new_ang.tolist()

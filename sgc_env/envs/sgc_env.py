@@ -84,12 +84,10 @@ that is not terminal: ``info["spin_clamped"]`` flags it (the physics is then no 
 
 ## Info
 
-Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_goal_index``
-(index into the body's goal list, -1 without a track), ``position_deviation``,
-``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
-``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
-``{body, goal, time, position_error, orientation_error}`` (|D| and the angle between body and
-goal orientation, in [0, pi], at that tick; None for a missing part).
+Per the contract of docs/design.md (:mod:`sgc_env.envs.step_info` builds it): per-body goal
+indices, deviations, times to goal, body and point states, force and torque, ``spin_clamped``,
+and on goal ticks ``goal_reached``: ``{body, goal, time, position_error, orientation_error}``
+(|D| and the body-goal angle in [0, pi] at that tick; None for a missing part).
 
 ## Arguments
 
@@ -107,16 +105,15 @@ plain reset).
 from __future__ import annotations
 
 import struct
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, TypedDict, cast
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.episode_steps import check_episode_length, scenario_steps
+from sgc_env.episode_steps import check_registered_length, scenario_steps
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
 from sgc_env.random_scenarios import PRESETS, SceneFamily
 from sgc_env.random_scenarios import random_scenario as draw_random_scenario
@@ -127,6 +124,8 @@ from sgc_env.simulator import Drive, Simulator
 from .actuation import Actuation, clip_action
 from .props import PropPaths
 from .rewards import make_reward
+from .snapshots import SavedState
+from .step_info import StepInfo, step_info
 from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
 from .world import SharedWorld
 
@@ -135,46 +134,6 @@ __all__ = ["SGCEnv", "SavedState", "StepInfo"]
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
 SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
-
-# Per-body columns of the (bodies, block) record that info hands out as views; built once
-# because constructing the index tuples costs as much as the slicing itself.
-_BLOCK = ObservationLayout(1)
-_COL_DEV = np.s_[:, _BLOCK.body_slice(0, "position_deviation")]
-_COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
-_COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
-_COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
-_COL_OTL = np.s_[:, _BLOCK.body_slice(0, "orientation_time_left").start]
-_COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
-_COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
-_COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
-_COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
-
-
-class _StepInfoEveryStep(TypedDict):
-    time: float
-    goal_index: np.ndarray
-    orientation_goal_index: np.ndarray
-    position_deviation: np.ndarray
-    orientation_deviation: np.ndarray
-    time_to_goal: np.ndarray
-    orientation_time_to_goal: np.ndarray
-    body_position: np.ndarray
-    body_orientation: np.ndarray
-    body_velocity: np.ndarray
-    body_angular_velocity: np.ndarray
-    point_position: np.ndarray
-    point_velocity: np.ndarray
-    force: np.ndarray
-    torque: np.ndarray
-    spin_clamped: bool
-
-
-class StepInfo(_StepInfoEveryStep, total=False):
-    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
-    one row per body; ``goal_reached`` only on a tick where goals fall."""
-
-    goal_reached: list[GoalEvent]
-    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
 
 
 @dataclass(frozen=True)
@@ -185,39 +144,6 @@ class _Prepared:
     task: GoalTask
     max_steps: int
     props: PropPaths
-
-
-@dataclass(frozen=True)
-class SavedState:
-    """A snapshot from :meth:`SGCEnv.save_state`: the PyBullet state id plus env counters."""
-
-    bullet_state: int
-    counters: dict[str, Any]
-
-    def free(self) -> None:
-        """Free the PyBullet copy now instead of when this object is garbage-collected."""
-        release = getattr(self, "_release", None)
-        if release is not None:
-            release()
-
-    @property
-    def alive(self) -> bool:
-        """False once freed (explicitly or because its env closed)."""
-        release = getattr(self, "_release", None)
-        if release is None:
-            return True
-        details = release.peek()
-        return details is not None and _sim_open(details[2][0])
-
-
-def _sim_open(sim_ref: weakref.ref[Simulator]) -> bool:
-    sim = sim_ref()
-    return sim is not None and sim.client >= 0
-
-
-def _remove_state(sim_ref: weakref.ref[Simulator], state_id: int) -> None:
-    if _sim_open(sim_ref):
-        sim_ref().remove_state(state_id)  # type: ignore[union-attr]
 
 
 def _as_scenario(spec: Scenario | str | Path) -> Scenario:
@@ -393,7 +319,7 @@ class SGCEnv(gym.Env):
             self._world.check_gravity(s.gravity)
         max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
-        return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
+        return _Prepared(s, GoalTask(s), max_steps, props)
 
     def _commit(self, prepared: _Prepared) -> None:
         """Make a prepared scenario current. Rebuilding bodies is the one step that talks to
@@ -411,7 +337,6 @@ class SGCEnv(gym.Env):
         self.task = prepared.task
         self.max_steps = prepared.max_steps
         self._props = prepared.props
-        self._mass = [b.mass for b in s.bodies]
         self._actuation = Actuation(
             s, self.body_inertia, self._uids, use_torque=self.use_torque,
             substeps=self.substeps, sim_frequency=self.sim_frequency,
@@ -441,28 +366,12 @@ class SGCEnv(gym.Env):
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
-        self._check_length()
+        if self._world is None:  # the batched env checks against its own limit
+            check_registered_length(self.spec, self.max_steps)
         info = self._info([])
         if self.render_mode == "human":
             self.render()
         return self._obs, info
-
-    def _check_length(self) -> None:
-        """Made by ``gym.make`` from an id without an EpisodeLengthCheck wrapper (one would
-        stop ``gym.make_vec`` from using the batched env): refuse an episode longer than the
-        id's registered TimeLimit, which would cut it short silently. The env cannot see a
-        TimeLimit the caller chose; for longer episodes construct ``SGCEnv`` directly or use
-        ``gym.make_vec(id, ..., max_episode_steps=...)``."""
-        spec = self.spec
-        if spec is None or self._world is not None or spec.id not in gym.registry:
-            return
-        registered = gym.spec(spec.id)
-        if not registered.additional_wrappers:
-            check_episode_length(
-                spec.id, registered.max_episode_steps, self.max_steps,
-                "to gym.make_vec, or construct sgc_env.envs.SGCEnv directly (gym.make's own "
-                "max_episode_steps cannot reach the env)",
-            )  # fmt: skip
 
     def _reset_state(self) -> None:
         for uid, b in zip(self._uids, self.scenario.bodies, strict=True):
@@ -572,7 +481,7 @@ class SGCEnv(gym.Env):
                 self._observe(read=False)
         terminated = self._failed
         steps_left = self.max_steps - self._tick
-        reward = task.reward_function(task, values, events, terminated, steps_left)
+        reward = self._reward(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":
@@ -580,28 +489,9 @@ class SGCEnv(gym.Env):
         return self._obs, reward, terminated, truncated, info
 
     def _info(self, events: list[GoalEvent]) -> StepInfo:
-        block, tail = self._block, self._tail
-        info: StepInfo = {
-            "time": self._tick * self.dt,
-            "goal_index": self.task.goal_index.copy(),
-            "orientation_goal_index": self.task.orientation_goal_index.copy(),
-            "position_deviation": block[_COL_DEV],
-            "orientation_deviation": block[_COL_ODEV],
-            "time_to_goal": block[_COL_PTL],
-            "orientation_time_to_goal": block[_COL_OTL],
-            "body_position": block[_COL_POSITION],
-            "body_orientation": block[_COL_ORIENTATION],
-            "body_velocity": block[_COL_VELOCITY],
-            "body_angular_velocity": block[_COL_ANGULAR_VELOCITY],
-            "point_position": tail[0],
-            "point_velocity": block[_COL_POINT_VELOCITY],
-            "force": tail[1],
-            "torque": tail[2],
-            "spin_clamped": self._spin_clamped,
-        }
-        if events:
-            info["goal_reached"] = events
-        return info
+        return step_info(
+            self._block, self._tail, self.task, self._tick * self.dt, self._spin_clamped, events
+        )
 
     def _counters(self) -> dict[str, Any]:
         return {"tick": self._tick, "task": self.task.counters(), "scenario": self.scenario}
@@ -620,13 +510,7 @@ class SGCEnv(gym.Env):
         snapshot is garbage-collected, or when the env closes, whichever comes first.
         """
         self._check_open()
-        state = SavedState(self.sim.save_state(), self._counters())
-        object.__setattr__(
-            state,
-            "_release",
-            weakref.finalize(state, _remove_state, weakref.ref(self.sim), state.bullet_state),
-        )
-        return state
+        return SavedState.of(self.sim, self._counters())
 
     def free_state(self, state: SavedState) -> None:
         """Free a snapshot's PyBullet copy now (restoring it afterwards is an error)."""
@@ -661,12 +545,10 @@ class SGCEnv(gym.Env):
         dp, dl = np.asarray(linear, dtype=float), np.asarray(angular, dtype=float)
         if dp.shape != (3,) or dl.shape != (3,) or not np.all(np.isfinite([*dp, *dl])):
             raise ValueError(f"impulse must be two finite 3-vectors, got {linear!r}, {angular!r}")
-        pos, orn, lin, ang = self._states[i]
-        rm = self.sim.rotation_matrix(orn)
-        inverse_inertia = rm @ np.diag(1.0 / self.body_inertia[i]) @ rm.T
-        new_lin = np.asarray(lin) + dp / self._mass[i]
-        new_ang = np.asarray(ang) + inverse_inertia @ dl
-        self.sim.reset_body(self._uids[i], pos, orn, new_lin.tolist(), new_ang.tolist())
+        pos, orn, _, _ = self._states[i]
+        self.sim.reset_body(
+            self._uids[i], pos, orn, *self._actuation.impulse(i, self._states[i], dp, dl)
+        )
         self._observe()
         return self._obs
 
