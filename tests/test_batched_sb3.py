@@ -95,3 +95,25 @@ def test_adapter_refuses_bad_input() -> None:
     with pytest.raises(NotImplementedError, match="does not render"):
         env.get_images()
     env.close()
+
+
+@pytest.mark.parametrize("policy", ["dc", "mj"])
+def test_comparison_policies_run_on_the_batched_env(policy: str) -> None:
+    """They read each sub-env's scenario through ``envs`` (baselines.vector.sub_env)."""
+    from baselines.comparison_policies import DynamicConstraintsController, MinimumJerkController
+
+    cls = DynamicConstraintsController if policy == "dc" else MinimumJerkController
+    runs = []
+    for kind in ("batched", "dummy"):
+        vec = make_sgc_vec("SGCRod-v0", 2, seed=5, vec=kind)
+        controller = cls(vec)
+        obs = vec.reset()
+        trace = []
+        for _ in range(30):
+            actions = controller.predict(obs)[0]
+            obs, rewards, _, _ = vec.step(actions)
+            trace.append((actions, rewards))
+        runs.append(trace)
+        vec.close()
+    for (a, r), (b, s) in zip(*runs, strict=True):
+        assert np.array_equal(a, b) and np.array_equal(r, s)
