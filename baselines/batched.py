@@ -144,8 +144,10 @@ def make_sgc_vec(
         raise ValueError(f"vec: {env_id} has no batched env; use 'dummy' or 'subproc'")
     if vec != "batched":
         cls = SubprocVecEnv if vec == "subproc" else DummyVecEnv
+        # "module:id" makes gym.make import sgc_env first, also in SubprocVecEnv's workers
+        module_id = f"sgc_env:{env_id}" if has_batched(env_id) else env_id
         return make_vec_env(
-            env_id, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs or None, vec_env_cls=cls
+            module_id, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs or None, vec_env_cls=cls
         )
     env = BatchedVecEnv(env_id, n_envs, env_kwargs)
     if seed is not None:

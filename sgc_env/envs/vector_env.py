@@ -46,6 +46,14 @@ def batch_infos(infos: list[dict[str, Any]], indices: list[int], n: int) -> dict
     for key, js in present.items():
         first = infos[js[0]][key]
         rows = [indices[j] for j in js]
+        if len(js) == n and rows == list(range(n)) and isinstance(first, (np.ndarray, float)):
+            out[key] = (
+                np.stack([info[key] for info in infos])
+                if isinstance(first, np.ndarray)
+                else np.array([info[key] for info in infos])
+            )
+            out[f"_{key}"] = np.ones(n, dtype=bool)
+            continue
         if isinstance(first, np.ndarray):
             array = np.zeros((n, *first.shape), dtype=first.dtype)
         elif type(first) in (int, float, bool) or isinstance(first, np.number):
