@@ -63,6 +63,12 @@ def test_a_scenario_the_world_cannot_share_is_refused() -> None:
     moon = replace(vec.envs[0].scenario, gravity=(0.0, 0.0, -1.62))
     with pytest.raises(ValueError, match="sub-env 0: scenario gravity .* one gravity"):
         vec.reset(options={"scenario": moon})
+    vec.close()
+    vec = SGCVectorEnv(2, scenario="intercept")
+    scene = vec.envs[0].scenario  # its body collides; with a colliding prop, two objects do
+    touching = replace(scene, props=tuple(replace(p, collisions=True) for p in scene.props))
+    with pytest.raises(ValueError, match="sub-env 0: .* collide with each other"):
+        vec.reset(options={"scenario": touching})
     with pytest.raises(ValueError, match="does not render"):
         SGCVectorEnv(2, scenario="point_three_goals", render_mode="rgb_array")
     with pytest.raises(NotImplementedError, match="shares its PyBullet client"):

@@ -316,7 +316,7 @@ class SGCEnv(gym.Env):
                 f"{self.control_frequency} Hz"
             )
         if self._world is not None:
-            self._world.check_gravity(s.gravity)
+            self._world.check_scenario(s)
         max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
         props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
         return _Prepared(s, GoalTask(s), max_steps, props)
