@@ -6,10 +6,10 @@ is that configuration's alone: ``rss`` is the process's resident memory after th
 ``subproc`` plus its workers'), ``+rss`` the growth from before the env was made (the imports
 of Python, torch and SB3 are the difference). Env steps: SB3's VecEnv API on all three kinds,
 hover actions plus Gaussian noise (the same in every kind; episodes that end are reset and
-their resets are timed too). PPO: ``n_steps = max(8, 2048 // N)``, one epoch, minibatch
-``min(1024, rollout)``, two rollouts timed after one warm-up rollout. Ratios are against
-DummyVecEnv at the same N, measured in this run; read them, not the absolute rates, on a busy
-machine (``--repeats`` runs the kinds in turn and keeps each one's best rate).
+their resets are timed too). PPO: ``n_steps = max(8, rollout // N)`` (``--rollout``, 2048),
+one epoch, minibatch ``min(1024, N * n_steps)``, two rollouts timed after a warm-up one.
+Ratios are against DummyVecEnv at the same N, measured in this run; read them, not the
+absolute rates, on a busy machine (``--repeats`` runs the kinds in turn, keeps each's best).
 
     .venv/bin/python scripts/bench_vec.py --ids SGCRod-v0 --n 1 8 64 256 --ppo
 """
@@ -34,7 +34,7 @@ def _rss_mb(children: bool) -> float:
     return sum(p.memory_info().rss for p in procs) / 2**20
 
 
-def child(env_id: str, n: int, kind: str, steps: int, ppo: bool) -> dict[str, float]:
+def child(env_id: str, n: int, kind: str, steps: int, rollout: int) -> dict[str, float]:
     """One measurement (runs in its own process)."""
     import numpy as np
 
@@ -61,12 +61,12 @@ def child(env_id: str, n: int, kind: str, steps: int, ppo: bool) -> dict[str, fl
     rate = n * t_steps / (time.perf_counter() - started)
     out = {"env_steps_s": rate, "rss_mb": _rss_mb(kind == "subproc")}
     out["rss_growth_mb"] = out["rss_mb"] - before
-    if ppo:
+    if rollout:
         import torch
         from stable_baselines3 import PPO
 
         torch.set_num_threads(1)
-        n_steps = max(8, 2048 // n)
+        n_steps = max(8, rollout // n)
         model = PPO(
             "MlpPolicy", env, n_steps=n_steps, batch_size=min(1024, n * n_steps), n_epochs=1,
             seed=0, device="cpu",
@@ -86,6 +86,7 @@ def main() -> None:
     parser.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS))
     parser.add_argument("--steps", type=int, default=4000, help="env steps timed per config")
     parser.add_argument("--ppo", action="store_true", help="also time PPO on each")
+    parser.add_argument("--rollout", type=int, default=2048, help="PPO's steps per rollout")
     parser.add_argument(
         "--repeats", type=int, default=1,
         help="run the kinds in turn this many times; the best rate of each is kept",
@@ -97,8 +98,8 @@ def main() -> None:
     parser.add_argument("--child", nargs=5, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        env_id, n, kind, steps, ppo = args.child
-        print(json.dumps(child(env_id, int(n), kind, int(steps), ppo == "1")))
+        env_id, n, kind, steps, rollout = args.child
+        print(json.dumps(child(env_id, int(n), kind, int(steps), int(rollout))))
         return
     import sgc_env
 
@@ -113,7 +114,7 @@ def main() -> None:
             for _ in range(args.repeats):
                 for kind in kinds:
                     cmd = [sys.executable, __file__, "--child", env_id, str(n), kind,
-                           str(args.steps), "1" if args.ppo else "0"]  # fmt: skip
+                           str(args.steps), str(args.rollout if args.ppo else 0)]  # fmt: skip
                     done = subprocess.run(cmd, capture_output=True, text=True, cwd=root)
                     if done.returncode:
                         print(f"{env_id:22} {n:>4} {kind:8} failed: {done.stderr[-300:]}")
