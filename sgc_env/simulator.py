@@ -167,10 +167,6 @@ class Simulator:
         self.bodies[name] = handle
         return handle
 
-    def built(self, collides: Sequence[tuple[str, bool]]) -> None:
-        """Called once a scene's bodies exist, with each body's name and collision flag (a
-        batched world sets its collision filters here; a client of its own needs nothing)."""
-
     def remove_body(self, name: str) -> None:
         handle = self.bodies.pop(name)
         pybullet.removeBody(handle.uid, physicsClientId=self.client)

@@ -286,9 +286,6 @@ class SGCEnv(gym.Env):
             self.sim.add_body(
                 p.name, p.shape, p.size, 0.0, p.color, kinematic=True, collisions=p.collisions
             )
-        self.sim.built(
-            [(b.name, b.collisions) for b in s.bodies] + [(p.name, p.collisions) for p in s.props]
-        )
         self._uids = [self.sim.bodies[b.name].uid for b in s.bodies]
         self._prop_uids = [self.sim.bodies[p.name].uid for p in s.props]
         self.body_inertia = np.array([self.sim.inertia_diagonal(b.name) for b in s.bodies])
