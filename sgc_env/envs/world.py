@@ -20,6 +20,7 @@ gravity per client), a different simulation frequency, and snapshots of a single
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 from sgc_env.scenario import Scenario
@@ -89,40 +90,22 @@ class WorldView(Simulator):
         self._get_pose = world.sim._get_pose
         self._get_velocity = world.sim._get_velocity
 
-    def add_body(
-        self,
-        name: str,
-        shape: str,
-        size: Sequence[float],
-        mass: float,
-        color: Sequence[float],
-        *,
-        kinematic: bool = False,
-        collisions: bool = True,
-    ) -> BodyHandle:
+    def add_body(self, name: str, *args: Any, **kwargs: Any) -> BodyHandle:
         """A body without a collision shape, so the broadphase never sees it (N scenes at the
         same coordinates would make every pair of their objects overlap, O(N^2) per substep),
-        with the inertia PyBullet computes for the shape (read off a throwaway body)."""
+        with the mass and inertia PyBullet computes for the shape (read off a probe body made
+        by :meth:`Simulator.add_body`); no visual shape either (the batched env never renders).
+        """
         pb, c = pybullet, self.client
-        if name in self.bodies:
-            raise ValueError(f"a body named {name!r} already exists")
-        col, vis = self._shapes(shape, size, color, collide=True)
-        base_mass = 0.0 if kinematic else float(mass)
-        probe = pb.createMultiBody(
-            baseMass=base_mass, baseCollisionShapeIndex=col, physicsClientId=c
-        )
-        inertia = pb.getDynamicsInfo(probe, -1, physicsClientId=c)[2]
-        pb.removeBody(probe, physicsClientId=c)
-        uid = pb.createMultiBody(
-            baseMass=base_mass, baseCollisionShapeIndex=-1, baseVisualShapeIndex=vis,
-            physicsClientId=c,
-        )  # fmt: skip
+        probe = super().add_body(name, *args, **kwargs)
+        mass, _, inertia = pb.getDynamicsInfo(probe.uid, -1, physicsClientId=c)[:3]
+        super().remove_body(name)
+        uid = pb.createMultiBody(baseMass=mass, physicsClientId=c)
         pb.changeDynamics(
             uid, -1, linearDamping=0.0, angularDamping=0.0, localInertiaDiagonal=inertia,
             physicsClientId=c,
         )  # fmt: skip
-        handle = BodyHandle(name, uid, shape, tuple(size), float(mass))
-        self.bodies[name] = handle
+        self.bodies[name] = handle = replace(probe, uid=uid)
         return handle
 
     def set_gravity(self, gravity: Sequence[float]) -> None:
