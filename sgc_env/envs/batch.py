@@ -28,10 +28,9 @@ from .world import SharedWorld
 __all__ = ["MAX_ENVS", "Batch", "check_num_envs"]
 
 MAX_ENVS = 1024
-"""Most sub-envs per world. Why a cap: sub-envs of one world share its C++ broadphase and
-collision-filter rules (between class-mates of different sub-envs: about
-``N^2 / (2 * 30) * bodies^2``, 157k for 1024 three-rod scenes), and the per-step Python work
-grows with N while PPO gains nothing from batches this large (scripts/bench_vec.py)."""
+"""Most sub-envs per world. Why a cap: memory stays near 1 GB for three-rod scenes (~1 MB each),
+larger worlds were never measured, and the per-step cost only grows with N (in
+scripts/bench_vec.py runs 256 rods were already slower per env-step than 64)."""
 
 StepResult = tuple[Any, float, bool, bool, Any]
 
