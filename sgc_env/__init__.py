@@ -49,8 +49,16 @@ for _id, (_entry, _kwargs) in _REGISTRY.items():
             entry_point=_entry,
             kwargs=_kwargs,
             max_episode_steps=registered_steps(_kwargs),
+            # Gymnasium's make_vec refuses ids with additional wrappers, so SGCEnv ids check
+            # their episode length in the env itself (SGCEnv._check_length); the goal id needs
+            # GoalRewardAccess outermost and is batched with sgc_env.make_vec instead.
             additional_wrappers=(
-                (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else (_LENGTH_CHECK,)
+                (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else ()
+            ),
+            vector_entry_point=(
+                "sgc_env.envs.vector_env:SGCGoalVectorEnv"
+                if _entry.startswith(_GOAL)
+                else "sgc_env.envs.vector_env:SGCVectorEnv"
             ),
         )
 

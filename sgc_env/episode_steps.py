@@ -22,7 +22,14 @@ from sgc_env.scenario.load import builtin_data
 from sgc_env.scenario.model import grid_tick
 from sgc_env.scenes import SceneFamily, family
 
-__all__ = ["EpisodeLengthCheck", "random_steps_bound", "registered_steps", "scenario_steps"]
+__all__ = [
+    "EpisodeLengthCheck",
+    "check_episode_length",
+    "check_registered_length",
+    "random_steps_bound",
+    "registered_steps",
+    "scenario_steps",
+]
 
 
 def scenario_steps(scenario: Scenario) -> int:
@@ -55,6 +62,39 @@ def _builtin(name: str) -> Scenario:
     return scenario_from_dict(builtin_data(name), name=name)
 
 
+def check_episode_length(
+    env_id: str, limit: int | None, needed: int, remedy: str = "to gym.make or gym.make_vec"
+) -> None:
+    """A ValueError when the registry's own TimeLimit of ``env_id`` (``limit``, the steps an
+    episode may last) would end an episode of ``needed`` steps early; a limit the caller chose
+    (any other value) is left alone. ``remedy`` ends the message (where to pass a limit)."""
+    if limit is None or needed <= limit or env_id not in gym.registry:
+        return
+    if limit == gym.spec(env_id).max_episode_steps:
+        raise ValueError(
+            f"{env_id}: this episode lasts {needed} steps but the registered TimeLimit ends "
+            f"episodes after {limit}; pass max_episode_steps={needed} (or -1 for no TimeLimit) "
+            f"{remedy}"
+        )
+
+
+def check_registered_length(spec: Any, needed: int) -> None:
+    """For an env made by ``gym.make`` (its ``spec``) from an id without an
+    :class:`EpisodeLengthCheck` wrapper (one would stop ``gym.make_vec`` from using the batched
+    env): refuse an episode longer than the id's registered TimeLimit, which would cut it
+    short silently. The env cannot see a TimeLimit the caller chose; longer episodes run on
+    ``SGCEnv`` made directly or through ``gym.make_vec(id, ..., max_episode_steps=...)``."""
+    if spec is None or spec.id not in gym.registry:
+        return
+    registered = gym.spec(spec.id)
+    if not registered.additional_wrappers:
+        check_episode_length(
+            spec.id, registered.max_episode_steps, needed,
+            "to gym.make_vec, or construct sgc_env.envs.SGCEnv directly (gym.make's own "
+            "max_episode_steps cannot reach the env)",
+        )  # fmt: skip
+
+
 class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
     """Refuses, at reset, an episode that the registered ``TimeLimit`` would end too early.
 
@@ -70,13 +110,6 @@ class EpisodeLengthCheck(gym.Wrapper, gym.utils.RecordConstructorArgs):
         result = self.env.reset(**kwargs)
         spec, base = self.env.spec, self.env.unwrapped
         limit = None if spec is None else spec.max_episode_steps
-        needed = int(getattr(base, "max_steps", 0))
-        if limit is not None and needed > limit and base.spec is not None:
-            registered = gym.spec(base.spec.id).max_episode_steps
-            if limit == registered:
-                raise ValueError(
-                    f"{base.spec.id}: this episode lasts {needed} steps but the registered "
-                    f"TimeLimit ends episodes after {limit}; pass max_episode_steps={needed} "
-                    "(or -1 for no TimeLimit) to gym.make"
-                )
+        if base.spec is not None:
+            check_episode_length(base.spec.id, limit, int(getattr(base, "max_steps", 0)))
         return result

@@ -110,12 +110,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 rows (and itself)."""
 
 KNOWN_CIRCLES: set[frozenset[str]] = {
-    frozenset({"sgc_env.envs.rewards", "sgc_env.envs.task"}),  # fixed on branch vec
 }
 """Module pairs whose circle is known and being removed elsewhere."""
 
 KNOWN_LONG_MODULES = {
-    "sgc_env/envs/sgc_env.py",  # split on branch vec (actuation out of step and _commit)
 }
 MAX_LINES = 600
 MAX_LOOSE_MODULES = 8

@@ -14,6 +14,7 @@ from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import sgc_env
 from baselines import SGCExpert
+from sgc_env.envs import SGCEnv
 from sgc_env.episode_steps import random_steps_bound, scenario_steps
 from sgc_env.scenes import PRESETS, random_scenario
 
@@ -86,7 +87,19 @@ def test_a_longer_episode_than_the_registered_limit_is_refused() -> None:
     with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
         env.reset(seed=0)
     env.close()
-    for steps in (-1, 420, 100):  # the caller's own limit (or none) is respected
-        env = gym.make("SGCPoint-v0", max_episode_steps=steps, **kwargs)
-        env.reset(seed=0)
-        env.close()
+    # The caller's own limit (or none) is respected where the env can see it: gym.make's
+    # TimeLimit is invisible to the env (no wrapper may check it: make_vec refuses ids with
+    # additional wrappers), so a longer episode is made directly or through make_vec.
+    direct = SGCEnv(**kwargs)
+    direct.reset(seed=0)
+    direct.close()
+    for steps in (-1, 420, 100):
+        vec = gym.make_vec(
+            "SGCPoint-v0", 2, "vector_entry_point", max_episode_steps=steps, **kwargs
+        )
+        vec.reset(seed=0)
+        vec.close()
+    vec = gym.make_vec("SGCPoint-v0", 2, "vector_entry_point", **kwargs)
+    with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
+        vec.reset(seed=0)
+    vec.close()

@@ -63,6 +63,7 @@ class TrainConfig:
     checkpoint_freq: int = 0
     verbose: int = 0
     command: str = ""
+    vec: str | None = None  # batched | dummy | subproc; None: batched where the id has it
 
 
 @dataclass
@@ -80,10 +81,10 @@ class TrainResult:
     bc: dict[str, Any] | None = None
 
 
-def _make_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any]):
-    from stable_baselines3.common.env_util import make_vec_env
+def _make_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], vec: str | None):
+    from baselines.batched import make_sgc_vec
 
-    return make_vec_env(env_id, n_envs=n_envs, seed=seed, env_kwargs=env_kwargs or None)
+    return make_sgc_vec(env_id, n_envs, seed, env_kwargs, vec)
 
 
 def _action_noise(hp, action_space: gym.spaces.Box):
@@ -152,7 +153,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     hp = load_hyperparams(cfg.algo, cfg.env_id, cfg.hyperparams_dir)
     total = hp.n_timesteps if cfg.timesteps is None else int(cfg.timesteps)
     set_random_seed(cfg.seed)
-    env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs)
+    env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs, cfg.vec)
     if hp.normalize:
         env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
     kwargs = dict(hp.algo_kwargs)

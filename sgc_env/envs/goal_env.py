@@ -74,8 +74,13 @@ class SGCGoalEnv(SGCEnv):
     def step(  # type: ignore[override]  # a Dict observation where SGCEnv has a Box
         self, action: np.ndarray
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, StepInfo]:
+        return super().step(action)  # type: ignore[return-value]  # via _finish_step below
+
+    def _finish_step(
+        self, values: list[float]
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, StepInfo]:
         desired = self._last["desired_goal"]
-        _, _, terminated, truncated, info = super().step(action)
+        _, _, terminated, truncated, info = super()._finish_step(values)
         if terminated:
             info["failure_charge"] = float(self.max_steps - self._tick)
         obs = self._dict_obs()

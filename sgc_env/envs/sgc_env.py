@@ -84,12 +84,10 @@ that is not terminal: ``info["spin_clamped"]`` flags it (the physics is then no 
 
 ## Info
 
-Per the contract of docs/design.md: ``time``, ``goal_index`` and ``orientation_goal_index``
-(index into the body's goal list, -1 without a track), ``position_deviation``,
-``orientation_deviation``, ``time_to_goal``, ``body_*``, ``point_position``, ``point_velocity``,
-``force``, ``torque``, ``spin_clamped``, and on goal ticks ``goal_reached``: a list of
-``{body, goal, time, position_error, orientation_error}`` (|D| and the angle between body and
-goal orientation, in [0, pi], at that tick; None for a missing part).
+Per the contract of docs/design.md (:mod:`sgc_env.envs.step_info` builds it): per-body goal
+indices, deviations, times to goal, body and point states, force and torque, ``spin_clamped``,
+and on goal ticks ``goal_reached``: ``{body, goal, time, position_error, orientation_error}``
+(|D| and the body-goal angle in [0, pi] at that tick; None for a missing part).
 
 ## Arguments
 
@@ -108,131 +106,38 @@ plain reset).
 
 from __future__ import annotations
 
-import math
 import struct
-import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, TypedDict, cast
+from typing import Any, cast
 
 import gymnasium as gym
 import numpy as np
 
-from sgc_env.episode_steps import scenario_steps
+from sgc_env.episode_steps import check_registered_length
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
-from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.render.camera import View
 from sgc_env.render.modes import available_render_modes
 from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
-from sgc_env.scenario import Scenario, load_scenario, resolve_scenario
+from sgc_env.scenario import Scenario, resolve_scenario
 from sgc_env.scenes import PRESETS, SceneFamily
 from sgc_env.scenes import random_scenario as draw_random_scenario
 from sgc_env.simulator import Drive, Simulator
 
-from .props import PropPaths
+from .actuation import Actuation, clip_action
+from .prepare import Prepared, as_scenario, prepare_scenario, scene_geometry
 from .rewards import make_reward
-from .task import GoalEvent, GoalTask, RewardFunction, TaskCounters
+from .snapshots import SavedState
+from .step_info import StepInfo, step_info
+from .task import GoalEvent, RewardFunction, TaskCounters
+from .world import SharedWorld
 
 __all__ = ["SGCEnv", "SavedState", "StepInfo"]
 
 OBS_BOUND = 1e5
 MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
 SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
-
-# Per-body columns of the (bodies, block) record that info hands out as views; built once
-# because constructing the index tuples costs as much as the slicing itself.
-_BLOCK = ObservationLayout(1)
-_COL_DEV = np.s_[:, _BLOCK.body_slice(0, "position_deviation")]
-_COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
-_COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
-_COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
-_COL_OTL = np.s_[:, _BLOCK.body_slice(0, "orientation_time_left").start]
-_COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
-_COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
-_COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
-_COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
-
-
-class _StepInfoEveryStep(TypedDict):
-    time: float
-    goal_index: np.ndarray
-    orientation_goal_index: np.ndarray
-    position_deviation: np.ndarray
-    orientation_deviation: np.ndarray
-    time_to_goal: np.ndarray
-    orientation_time_to_goal: np.ndarray
-    body_position: np.ndarray
-    body_orientation: np.ndarray
-    body_velocity: np.ndarray
-    body_angular_velocity: np.ndarray
-    point_position: np.ndarray
-    point_velocity: np.ndarray
-    force: np.ndarray
-    torque: np.ndarray
-    spin_clamped: bool
-
-
-class StepInfo(_StepInfoEveryStep, total=False):
-    """The ``info`` of ``reset`` and ``step`` (see the module docstring): per-body arrays with
-    one row per body; ``goal_reached`` only on a tick where goals fall."""
-
-    goal_reached: list[GoalEvent]
-    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
-
-
-@dataclass(frozen=True)
-class _Prepared:
-    """A scenario checked against an env, with what it compiles to (see SGCEnv._prepare)."""
-
-    scenario: Scenario
-    task: GoalTask
-    max_steps: int
-    props: PropPaths
-
-
-@dataclass(frozen=True)
-class SavedState:
-    """A snapshot from :meth:`SGCEnv.save_state`: the PyBullet state id plus env counters."""
-
-    bullet_state: int
-    counters: dict[str, Any]
-
-    def free(self) -> None:
-        """Free the PyBullet copy now instead of when this object is garbage-collected."""
-        release = getattr(self, "_release", None)
-        if release is not None:
-            release()
-
-    @property
-    def alive(self) -> bool:
-        """False once freed (explicitly or because its env closed)."""
-        release = getattr(self, "_release", None)
-        if release is None:
-            return True
-        details = release.peek()
-        return details is not None and _sim_open(details[2][0])
-
-
-def _sim_open(sim_ref: weakref.ref[Simulator]) -> bool:
-    sim = sim_ref()
-    return sim is not None and sim.client >= 0
-
-
-def _remove_state(sim_ref: weakref.ref[Simulator], state_id: int) -> None:
-    if _sim_open(sim_ref):
-        sim_ref().remove_state(state_id)  # type: ignore[union-attr]
-
-
-def _as_scenario(spec: Scenario | str | Path) -> Scenario:
-    return spec if isinstance(spec, Scenario) else load_scenario(spec)
-
-
-def _geometry(s: Scenario) -> tuple:
-    return (
-        tuple((b.name, b.shape, b.size, b.mass, b.color, b.collisions) for b in s.bodies),
-        tuple((p.name, p.shape, p.size, p.color, p.collisions) for p in s.props),
-    )
 
 
 class SGCEnv(gym.Env):
@@ -253,6 +158,7 @@ class SGCEnv(gym.Env):
         width: int = 640,
         height: int = 480,
         reward: str = "schedule",
+        world: SharedWorld | None = None,
     ) -> None:
         self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
@@ -283,7 +189,7 @@ class SGCEnv(gym.Env):
             self._random_config = cfg
             base = draw_random_scenario(np.random.default_rng(0), cfg)
         else:
-            base = _as_scenario(scenario)
+            base = as_scenario(scenario)
         self._control_override = control_frequency
         self._time_grid = time_grid
         base = self._resolve(base)
@@ -296,8 +202,6 @@ class SGCEnv(gym.Env):
             )
         self.control_frequency = cf
         self.substeps = self.sim_frequency // cf
-        h = 1.0 / self.sim_frequency
-        self._substep_coef = [(k * h, h * h * k * (k + 1) / 2) for k in range(self.substeps)]
         self.dt = 1.0 / cf
         # "human" is offered only where a display exists, so headless checkers do not open a GUI.
         self.metadata = {
@@ -326,8 +230,17 @@ class SGCEnv(gym.Env):
         self._geometry: tuple = ()
         # Everything that can reject the scenario runs before the PyBullet client exists; if
         # building the scene still fails, the client is closed before the error propagates.
+        self._world = world
+        if world is not None:
+            if render_mode is not None:
+                raise ValueError("render_mode: a sub-env of a batched env does not render")
+            world.check_frequency(self.sim_frequency)
         prepared = self._prepare(base)
-        self.sim = Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+        self.sim = (
+            Simulator(gui=render_mode == "human", sim_frequency=self.sim_frequency)
+            if world is None
+            else world.view()
+        )
         try:
             self._build(base)
             self._commit(prepared)
@@ -362,36 +275,26 @@ class SGCEnv(gym.Env):
         self._uids = [self.sim.bodies[b.name].uid for b in s.bodies]
         self._prop_uids = [self.sim.bodies[p.name].uid for p in s.props]
         self.body_inertia = np.array([self.sim.inertia_diagonal(b.name) for b in s.bodies])
-        self._geometry = _geometry(s)
+        self._geometry = scene_geometry(s)
 
     def _set_scenario(self, s: Scenario) -> None:
         """Switch to ``s`` all at once: everything is checked and compiled before the env
         changes, so a rejected scenario leaves the env exactly as it was."""
         self._commit(self._prepare(s))
 
-    def _prepare(self, s: Scenario) -> _Prepared:
+    def _prepare(self, s: Scenario) -> Prepared:
         """Check ``s`` against this env and compile its tracks; changes nothing."""
-        if len(s.bodies) != self._n:
-            raise ValueError(
-                f"scenario has {len(s.bodies)} bodies, this env was made for {self._n}"
-            )
-        use_torque = not all(b.shape == "sphere" and not b.has_orientation_track for b in s.bodies)
-        if use_torque and not self.use_torque:
-            raise ValueError("scenario needs torques but this env's action space has forces only")
-        if s.control_frequency != self.control_frequency:
-            raise ValueError(
-                f"scenario control_frequency {s.control_frequency} Hz differs from the env's "
-                f"{self.control_frequency} Hz"
-            )
-        max_steps = scenario_steps(s)  # the registry's max_episode_steps counts the same
-        props = PropPaths(s.props, self.sim_frequency, (max_steps + 1) * self.substeps)
-        return _Prepared(s, GoalTask(s, self._reward), max_steps, props)
+        return prepare_scenario(
+            s, n_bodies=self._n, use_torque=self.use_torque,
+            control_frequency=self.control_frequency, sim_frequency=self.sim_frequency,
+            world=self._world,
+        )  # fmt: skip
 
-    def _commit(self, prepared: _Prepared) -> None:
+    def _commit(self, prepared: Prepared) -> None:
         """Make a prepared scenario current. Rebuilding bodies is the one step that talks to
         PyBullet; if it fails, the previous scene is rebuilt before the error propagates."""
         s = prepared.scenario
-        if _geometry(s) != self._geometry:
+        if scene_geometry(s) != self._geometry:
             previous = self.scenario
             try:
                 self._build(s)
@@ -400,17 +303,14 @@ class SGCEnv(gym.Env):
                 raise
         self.scenario = s
         self.sim.set_gravity(s.gravity)
-        self._gravity = tuple(float(g) for g in s.gravity)
         self.task = prepared.task
         self.max_steps = prepared.max_steps
         self._props = prepared.props
-        self._mass = [b.mass for b in s.bodies]
-        self._flimit = [float(b.force_limit) for b in s.bodies]
-        self.torque_scale = np.array(
-            [float(b.torque_limit) * inertia / inertia.max()
-             for b, inertia in zip(s.bodies, self.body_inertia, strict=True)]
+        self._actuation = Actuation(
+            s, self.body_inertia, self._uids, use_torque=self.use_torque,
+            substeps=self.substeps, sim_frequency=self.sim_frequency,
         )  # fmt: skip
-        self._tscale = [tuple(row) for row in self.torque_scale.tolist()]
+        self.torque_scale = self._actuation.torque_scale
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
@@ -426,13 +326,15 @@ class SGCEnv(gym.Env):
         prepared = None
         if options.get("scenario") is not None:
             # Checked and compiled before the seed or anything else changes (transactional).
-            prepared = self._prepare(self._resolve(_as_scenario(options["scenario"])))
+            prepared = self._prepare(self._resolve(as_scenario(options["scenario"])))
         super().reset(seed=seed)
         if prepared is not None:
             self._commit(prepared)
         elif self._random_config is not None:
             self._set_scenario(draw_random_scenario(self.np_random, self._random_config))
         self._reset_state()
+        if self._world is None:  # the batched env checks against its own limit
+            check_registered_length(self.spec, self.max_steps)
         info = self._info([])
         if self.render_mode == "human":
             self.render()
@@ -447,8 +349,7 @@ class SGCEnv(gym.Env):
             for uid, pos in zip(self._prop_uids, self._props.at(0), strict=True):
                 self.sim.move(uid, pos)
         self._tick = 0
-        self._zeros3n = [0.0] * (3 * self._n)
-        self._applied = [0.0] * (6 * self._n)
+        self._applied = self._actuation.idle
         self.task.reset()
         self._observe()
 
@@ -514,49 +415,17 @@ class SGCEnv(gym.Env):
     ) -> tuple[np.ndarray, float, bool, bool, StepInfo]:
         if self._closed:
             self._check_open()
-        a = action if type(action) is np.ndarray else np.asarray(action)
-        if a.dtype.kind not in "fiu":
-            raise TypeError(f"action must hold real numbers, got dtype {a.dtype}: {action!r}")
-        if a.shape != self._action_shape:
-            raise ValueError(f"action has shape {a.shape}, expected {self._action_shape}")
-        values = a.tolist()
-        hi, lo = max(values), min(values)
-        if hi > 1.0 or lo < -1.0:
-            if hi == math.inf or lo == -math.inf:
-                raise ValueError(f"action contains non-finite values: {values}")
-            values = [-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in values]
-        # Clipped first, so the sum cannot overflow: it is NaN only if an entry is.
-        if math.isnan(sum(values)):
-            raise ValueError(f"action contains non-finite values: {values}")
-        use_torque = self.use_torque
-        per = 6 if use_torque else 3
-        gx, gy, gz = self._gravity
-        coef = self._substep_coef
-        drives: list[Drive] = []
-        applied_f: list[float] = []
-        applied_t: list[float] = []
-        for i, (pos, orn, lin, _) in enumerate(self._states):
-            fl = self._flimit[i]
-            o = i * per
-            fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
-            f = (fx, fy, fz)
-            applied_f += f
-            tq = None
-            if use_torque:
-                sx, sy, sz = self._tscale[i]
-                bx, by, bz = rotate_back(orn, (values[o + 3], values[o + 4], values[o + 5]))
-                tq = rotate(orn, (bx * sx, by * sy, bz * sz))
-                applied_t += tq
-            m = self._mass[i]
-            ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
-            x0, y0, z0 = pos
-            vx, vy, vz = lin
-            # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
-            path = [
-                (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
-                for kh, c in coef
-            ]
-            drives.append((self._uids[i], f, tq, path))
+        values = clip_action(action, self._action_shape)
+        drives, moves = self._drives(values)
+        self.sim.step_bodies(drives, moves)
+        return self._finish_step(values)
+
+    def _drives(
+        self, values: list[float]
+    ) -> tuple[list[Drive], list[list[tuple[int, tuple[float, ...]]]]]:
+        """The bodies' drives and the props' moves (one list per substep) of the next control
+        period; the batched env gathers these from every sub-env into one physics step."""
+        drives, self._applied = self._actuation.drives(values, self._states)
         moves: list[list[tuple[int, tuple[float, ...]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
@@ -565,8 +434,10 @@ class SGCEnv(gym.Env):
                 list(zip(self._prop_uids, at(base + k + 1), strict=True))
                 for k in range(self.substeps)
             ]
-        self.sim.step_bodies(drives, moves)
-        self._applied = applied_f + (applied_t or self._zeros3n)
+        return drives, moves
+
+    def _finish_step(self, values: list[float]) -> tuple[Any, float, bool, bool, StepInfo]:
+        """Everything after the physics of a control step: observe, goal events, reward."""
         self._tick += 1
         self._observe()
         task = self.task
@@ -577,7 +448,7 @@ class SGCEnv(gym.Env):
                 self._observe(read=False)
         terminated = self._failed
         steps_left = self.max_steps - self._tick
-        reward = task.reward_function(task, values, events, terminated, steps_left)
+        reward = self._reward(task, values, events, terminated, steps_left)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":
@@ -585,28 +456,9 @@ class SGCEnv(gym.Env):
         return self._obs, reward, terminated, truncated, info
 
     def _info(self, events: list[GoalEvent]) -> StepInfo:
-        block, tail = self._block, self._tail
-        info: StepInfo = {
-            "time": self._tick * self.dt,
-            "goal_index": self.task.goal_index.copy(),
-            "orientation_goal_index": self.task.orientation_goal_index.copy(),
-            "position_deviation": block[_COL_DEV],
-            "orientation_deviation": block[_COL_ODEV],
-            "time_to_goal": block[_COL_PTL],
-            "orientation_time_to_goal": block[_COL_OTL],
-            "body_position": block[_COL_POSITION],
-            "body_orientation": block[_COL_ORIENTATION],
-            "body_velocity": block[_COL_VELOCITY],
-            "body_angular_velocity": block[_COL_ANGULAR_VELOCITY],
-            "point_position": tail[0],
-            "point_velocity": block[_COL_POINT_VELOCITY],
-            "force": tail[1],
-            "torque": tail[2],
-            "spin_clamped": self._spin_clamped,
-        }
-        if events:
-            info["goal_reached"] = events
-        return info
+        return step_info(
+            self._block, self._tail, self.task, self._tick * self.dt, self._spin_clamped, events
+        )
 
     def _counters(self) -> dict[str, Any]:
         return {"tick": self._tick, "task": self.task.counters(), "scenario": self.scenario}
@@ -625,13 +477,7 @@ class SGCEnv(gym.Env):
         snapshot is garbage-collected, or when the env closes, whichever comes first.
         """
         self._check_open()
-        state = SavedState(self.sim.save_state(), self._counters())
-        object.__setattr__(
-            state,
-            "_release",
-            weakref.finalize(state, _remove_state, weakref.ref(self.sim), state.bullet_state),
-        )
-        return state
+        return SavedState.of(self.sim, self._counters())
 
     def free_state(self, state: SavedState) -> None:
         """Free a snapshot's PyBullet copy now (restoring it afterwards is an error)."""
@@ -666,12 +512,10 @@ class SGCEnv(gym.Env):
         dp, dl = np.asarray(linear, dtype=float), np.asarray(angular, dtype=float)
         if dp.shape != (3,) or dl.shape != (3,) or not np.all(np.isfinite([*dp, *dl])):
             raise ValueError(f"impulse must be two finite 3-vectors, got {linear!r}, {angular!r}")
-        pos, orn, lin, ang = self._states[i]
-        rm = self.sim.rotation_matrix(orn)
-        inverse_inertia = rm @ np.diag(1.0 / self.body_inertia[i]) @ rm.T
-        new_lin = np.asarray(lin) + dp / self._mass[i]
-        new_ang = np.asarray(ang) + inverse_inertia @ dl
-        self.sim.reset_body(self._uids[i], pos, orn, new_lin.tolist(), new_ang.tolist())
+        pos, orn, _, _ = self._states[i]
+        self.sim.reset_body(
+            self._uids[i], pos, orn, *self._actuation.impulse(i, self._states[i], dp, dl)
+        )
         self._observe()
         return self._obs
 

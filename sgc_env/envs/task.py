@@ -1,12 +1,13 @@
-"""The goal-tracking task: which goal each body is on, its deviation from it, events, reward.
+"""The goal-tracking task: which goal each body is on, its deviation from it, goal events.
 
 The env's three parts follow panda-gym: the :class:`~sgc_env.simulator.Simulator` moves bodies,
 this :class:`GoalTask` judges them against the scenario's goals, and
 :class:`~sgc_env.envs.sgc_env.SGCEnv` joins the two with the observation layout. The task owns
 the compiled tracks, the current goal of every track, the deviations D, D' and the unwrapped
-rotation deviation phi, the goal events of a tick, the reward (through a
-:class:`RewardFunction`) and the goal-conditioned view (achieved and desired goal) that HER
-relabels. It never calls PyBullet: it is handed the bodies' states.
+rotation deviation phi, the goal events of a tick and the goal-conditioned view (achieved and
+desired goal) that HER relabels. It defines the :class:`RewardFunction` seam but picks no
+reward: the env calls its mode (:mod:`sgc_env.envs.rewards`, which imports this module, never
+the other way) with the task. It never calls PyBullet: it is handed the bodies' states.
 
 The per-step methods work on Python tuples, not numpy: for a few bodies that is several times
 cheaper (the env's step cost is measured in ``scripts/bench_env.py``).
@@ -27,7 +28,6 @@ from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
 from sgc_env.simulator import BodyState
 
-from .rewards import DistanceReward
 from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
@@ -107,7 +107,8 @@ class GoalTask:
     """Goal tracking of every body of one resolved scenario (see the module docstring).
 
     Per step the env calls :meth:`measure` with the bodies' states, then :meth:`advance` on a
-    tick where a goal falls (:attr:`next_event`), then :attr:`reward_function`. After
+    tick where a goal falls (:attr:`next_event`), then its :class:`RewardFunction` with this
+    task (the env owns the reward: this module never picks one). After
     :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
     tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
     (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`;
@@ -115,18 +116,11 @@ class GoalTask:
     scales (:attr:`position_scale` = 1 / L, :attr:`orientation_scale` = 1 / A).
     """
 
-    def __init__(
-        self,
-        scenario: Scenario,
-        reward: RewardFunction | None = None,
-        *,
-        scales: tuple = (0.1, 0.5),
-    ) -> None:
+    def __init__(self, scenario: Scenario, *, scales: tuple = (0.1, 0.5)) -> None:
         """``scales``: the floors (m, rad) of the per-course normalisers L and A."""
         self.tracks: list[BodyTracks] = compile_tracks(scenario)
         self.n_bodies = len(self.tracks)
         self.dt = 1.0 / scenario.control_frequency
-        self.reward_function: RewardFunction = reward if reward is not None else DistanceReward()
         self._min_length, self._min_angle = scales
         self.has_position = [bt.position is not None for bt in self.tracks]
         self.has_orientation = [bt.orientation is not None for bt in self.tracks]

@@ -84,6 +84,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--env-kwargs", type=env_kwargs, default=None, help="JSON dict passed to gym.make"
     )
     parser.add_argument("--device", default="cpu", help="torch device")
+    parser.add_argument(
+        "--vec", choices=("batched", "dummy", "subproc"), default=None,
+        help="training envs: batched (one PyBullet world, the default), dummy or subproc "
+        "(SB3's, of single envs); the same seeds give the same run with batched and dummy",
+    )  # fmt: skip
     parser.add_argument("--verbose", type=nonneg_int, default=0, help="SB3 verbosity (0, 1, 2)")
 
 
@@ -132,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
         critic_warmup=args.critic_warmup,
         dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
         hyperparams_dir=args.hyperparams, env_kwargs=args.env_kwargs or {}, device=args.device,
-        checkpoint_freq=args.checkpoint_freq, verbose=args.verbose,
+        checkpoint_freq=args.checkpoint_freq, verbose=args.verbose, vec=args.vec,
         command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip
     try:

@@ -1,0 +1,148 @@
+"""N sub-envs in one PyBullet world, stepped together: the core of both vector env APIs.
+
+Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) built on a
+:class:`~sgc_env.envs.world.WorldView` of one :class:`~sgc_env.envs.world.SharedWorld`, so its
+task logic, observation, reward and goal events are the single env's own code: a sub-env is a
+single env whose physics step is shared. A control step gathers every stepping sub-env's
+drives, runs the world's substeps once, then lets each sub-env observe. The Gymnasium
+(:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters differ only in their reset
+conventions and in how they batch what this returns.
+
+A sub-env that does not step in a call (it is being reset) still has bodies in the world that
+the substeps integrate; its reset comes after the physics and overwrites their state, so it
+starts exactly where a single env's reset would.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sgc_env.episode_steps import check_episode_length
+
+from .actuation import clip_action
+from .sgc_env import SGCEnv
+from .world import SharedWorld
+
+__all__ = ["MAX_ENVS", "Batch", "check_num_envs"]
+
+MAX_ENVS = 1024
+"""Most sub-envs per world. Why a cap: memory stays near 1 GB for three-rod scenes (~1 MB each),
+larger worlds were never measured, and the per-step cost only grows with N (in
+scripts/bench_vec.py runs 256 rods were already slower per env-step than 64)."""
+
+StepResult = tuple[Any, float, bool, bool, Any]
+
+
+def check_num_envs(num_envs: object) -> int:
+    """``num_envs`` as an int in [1, MAX_ENVS], else a ValueError naming it."""
+    if isinstance(num_envs, bool) or not isinstance(num_envs, int):
+        raise ValueError(f"num_envs must be an int, got {num_envs!r}")
+    if not 1 <= num_envs <= MAX_ENVS:
+        raise ValueError(
+            f"num_envs must be in [1, {MAX_ENVS}], got {num_envs} (the cap: see "
+            "sgc_env.envs.batch.MAX_ENVS)"
+        )
+    return num_envs
+
+
+class Batch:
+    """The sub-envs of one world (see the module docstring)."""
+
+    def __init__(
+        self,
+        num_envs: int,
+        env_class: type[SGCEnv],
+        kwargs: dict[str, Any],
+        *,
+        max_episode_steps: int | None = None,
+        env_id: str | None = None,
+    ) -> None:
+        n = check_num_envs(num_envs)
+        if kwargs.get("render_mode") is not None:
+            raise ValueError("render_mode: the batched env does not render; use a single env")
+        self.world = SharedWorld(int(kwargs.get("sim_frequency", 240)))
+        self.envs: list[SGCEnv] = []
+        try:
+            for _ in range(n):
+                self.envs.append(env_class(**kwargs, world=self.world))
+        except BaseException:
+            self.close()
+            raise
+        first = self.envs[0]
+        self.substeps = first.substeps
+        self.action_shape: tuple[int, ...] = first._action_shape
+        self.limit = (
+            None if max_episode_steps is None or max_episode_steps == -1 else int(max_episode_steps)
+        )
+        self.env_id = env_id
+        self.elapsed = [0] * n
+        self.closed = False
+
+    def __len__(self) -> int:
+        return len(self.envs)
+
+    def reset_one(
+        self, i: int, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Reset sub-env ``i`` (refusing an episode its time limit would cut short)."""
+        env = self.envs[i]
+        try:
+            obs, info = env.reset(seed=seed, options=options)
+        except ValueError as err:
+            raise ValueError(f"sub-env {i}: {err}") from err
+        if self.env_id is not None:
+            check_episode_length(self.env_id, self.limit, env.max_steps)
+        self.elapsed[i] = 0
+        return obs, dict(info)
+
+    def clip(self, actions: Any, indices: list[int]) -> list[list[float]]:
+        """Each listed sub-env's action row, clipped; errors name the sub-env."""
+        a = actions if type(actions) is np.ndarray else np.asarray(actions)
+        shape = (len(self.envs), *self.action_shape)
+        if a.shape != shape:
+            raise ValueError(f"actions have shape {a.shape}, expected {shape} (num_envs, action)")
+        rows = a[indices]
+        if a.dtype.kind in "fiu" and np.isfinite(rows).all():
+            return np.clip(rows, -1, 1).tolist()  # as clip_action, one call for all rows
+        out = []  # something is wrong: find the first bad row with the single env's check
+        for i in indices:
+            try:
+                out.append(clip_action(a[i], self.action_shape))
+            except (TypeError, ValueError) as err:
+                raise type(err)(f"sub-env {i}: {err}") from None
+        return out
+
+    def step(self, indices: list[int], values: list[list[float]]) -> list[StepResult]:
+        """One control step of the listed sub-envs (their clipped actions) in one world step;
+        the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
+        envs = self.envs
+        drives: list[Any] = []
+        moves: list[list[Any]] = [[] for _ in range(self.substeps)]
+        any_moves = False
+        for i, v in zip(indices, values, strict=True):
+            d, m = envs[i]._drives(v)
+            drives += d
+            if m:
+                any_moves = True
+                for k, mk in enumerate(m):
+                    moves[k] += mk
+        if drives:
+            self.world.sim.step_bodies(drives, moves if any_moves else ())
+        results = []
+        limit, elapsed = self.limit, self.elapsed
+        for i, v in zip(indices, values, strict=True):
+            obs, reward, terminated, truncated, info = envs[i]._finish_step(v)
+            elapsed[i] += 1
+            if limit is not None and elapsed[i] >= limit:
+                truncated = True
+            results.append((obs, reward, terminated, truncated, info))
+        return results
+
+    def close(self) -> None:
+        """Close every sub-env and free the client (idempotent)."""
+        for env in self.envs:
+            env.close()
+        self.world.close()
+        self.closed = True
