@@ -34,7 +34,7 @@ from baselines.expert import GOAL_TICK_SLACK, SGCExpert
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_env import BareLoop, env_step_us, fixed_env, hover_action  # noqa: E402
 
-ENV_IDS = ("SGCRod-v0", "SGCThreeRods-v0")
+ENV_IDS = ("SGCRod-v0", "SGCThreeRods-v1")
 
 
 def record_episodes(env_id: str, episodes: int) -> tuple[SGCExpert, list[np.ndarray], list[bool]]:

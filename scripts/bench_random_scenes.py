@@ -38,7 +38,7 @@ from sgc_env.scenes import intercept, random_scenario, three_rods_random
 TARGET_MS = 10.0
 """Issue 19's bound on a random id's reset (about a tenth of its episode's steps)."""
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
-         ("SGCThreeRods-v0", "SGCThreeRodsRandom-v0", "three_rods"))  # fmt: skip
+         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v1", "three_rods"))  # fmt: skip
 
 
 def _bare_reset_ms(resets: int) -> float:

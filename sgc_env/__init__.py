@@ -31,10 +31,10 @@ _STEPS = "sgc_env.episode_steps"
 _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
-    "SGCThreeRods-v0": (_ENTRY, {"scenario": "three_rods"}),
+    "SGCThreeRods-v1": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
     "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
-    "SGCThreeRodsRandom-v0": (_ENTRY, {"random_scenario": "three_rods"}),
+    "SGCThreeRodsRandom-v1": (_ENTRY, {"random_scenario": "three_rods"}),
     "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)

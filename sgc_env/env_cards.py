@@ -59,6 +59,11 @@ class EnvCard:
 
 
 _FIRST = "first release (the benchmark of issues 1-24)."
+_SMOOTH_SPLIT = (
+    "the somersault is split into unequal sub-rotations that follow a smooth rate profile "
+    "between the incoming and outgoing paces (issue 23), so the orientation sub-goals the "
+    "observation shows differ from v0's equal split."
+)
 _RANDOM_START = (
     "A new scene is drawn from the env's `np_random` on every reset (`reset(seed=...)`: same "
     "seed, same scene, bit for bit): "
@@ -116,15 +121,15 @@ CARDS: tuple[EnvCard, ...] = (
         "three hit the bullseye board. One scene (25/16/17 goals).",
         "The three rods at the scene's launch poses, x about -9.2 m, flying at 2-2.5 m/s "
         "towards the board at x = 8 m; the balls at their start points. No noise.",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT)),
     ),
     EnvCard(
         "SGCThreeRodsRandom",
-        "`SGCThreeRods-v0` with the paths, goal counts, balls and times drawn per reset.",
+        "`SGCThreeRods-v1` with the paths, goal counts, balls and times drawn per reset.",
         _RANDOM_START + "every waypoint of the paper's paths moved by up to 0.4 m, pierce "
         "times 1.0-1.4 s, hit times within 0.4 s of the paper's, ball velocities 0.5-1.2 m/s, "
         "and only draws whose plan needs at most 80 % of each limit.",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT)),
     ),
 )
 

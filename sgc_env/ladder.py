@@ -38,12 +38,12 @@ LADDER: tuple[Rung, ...] = (
     Rung("SGCPointGoal-v0", "`SGCPoint-v0` as a goal-conditioned task (Dict observation, HER)"),
     Rung("SGCRod-v0", "position and orientation together: torques on a thin rod"),
     Rung(
-        "SGCThreeRods-v0",
+        "SGCThreeRods-v1",
         "the paper's scene: three rods, long point-to-path sequences, tip goals, moving balls, "
         "a somersault; one scene",
     ),
     Rung(
-        "SGCThreeRodsRandom-v0",
+        "SGCThreeRodsRandom-v1",
         "the same, with paths, goal counts, balls and times drawn per reset",
     ),
 )

@@ -230,9 +230,9 @@ def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
     from baselines.agents.pushes import Pushes
     from baselines.cli.commands import demos as demos_command
 
-    plain = record_demos("SGCThreeRods-v0", 2, seed=0)
-    pushed = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(**PUSHES))
-    again = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(**PUSHES))
+    plain = record_demos("SGCThreeRods-v1", 2, seed=0)
+    pushed = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(**PUSHES))
+    again = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(**PUSHES))
     np.testing.assert_array_equal(pushed.observations, again.observations)
     np.testing.assert_array_equal(pushed.actions, again.actions)
     first, second = (obs for obs in np.split(plain.observations, 2))
@@ -240,13 +240,13 @@ def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
     starts = np.flatnonzero(pushed.episode_starts)
     assert not np.array_equal(pushed.observations[starts[0]], plain.observations[0])
     assert not np.array_equal(pushed.observations[starts[0]], pushed.observations[starts[1]])
-    never = record_demos("SGCThreeRods-v0", 2, seed=0, pushes=Pushes(scale=0.5, prob=0.0))
+    never = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(scale=0.5, prob=0.0))
     np.testing.assert_array_equal(never.observations, plain.observations)
     path = tmp_path / "pushed.npz"
     parser = argparse.ArgumentParser()
     demos_command.add_arguments(parser)
     args = parser.parse_args(
-        ["--env", "SGCThreeRods-v0", "--episodes", "2", "--seed", "0", "--out", str(path),
+        ["--env", "SGCThreeRods-v1", "--episodes", "2", "--seed", "0", "--out", str(path),
          "--push-scale", "0.5", "--push-spin", "0.5", "--push-prob", "0.1", "--push-start"]
     )  # fmt: skip
     assert demos_command.run(args) == 0

@@ -16,7 +16,7 @@ from sgc_env.envs.rewards import REWARD_MODES
 from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
-SIZES = {"SGCThreeRodsRandom-v0": (2, 40), "SGCThreeRods-v0": (2, 45)}
+SIZES = {"SGCThreeRodsRandom-v1": (2, 40), "SGCThreeRods-v1": (2, 45)}
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -131,7 +131,7 @@ def test_every_id_equals_single_envs_under_random_actions(env_id: str) -> None:
 
 
 @pytest.mark.parametrize("reward", REWARD_MODES)
-@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v0", "SGCInterceptRandom-v0"])
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1", "SGCInterceptRandom-v0"])
 def test_every_reward_mode_equals_single_envs(env_id: str, reward: str) -> None:
     assert run_pair(env_id, 2, 50, reward=reward, max_episode_steps=20) >= 2
 

@@ -80,7 +80,7 @@ def test_a_failing_sub_env_leaves_the_others_alone() -> None:
     """Sub-env 0 thrusts out of the workspace and resets; sub-env 1 (on the same nails, the
     three-rod scene, whose bodies collide with each other) steps as a single env would."""
     vec = SGCVectorEnv(2, scenario="three_rods")
-    single = gym.make("SGCThreeRods-v0")
+    single = gym.make("SGCThreeRods-v1")
     vec.reset(seed=0)
     o, _ = single.reset(seed=1)
     expert = SGCExpert(single)  # keeps sub-env 1 inside the workspace

@@ -26,7 +26,7 @@ MIN_SPEED_FRACTION = 0.1
 
 @pytest.fixture(scope="module")
 def episode():
-    env = gym.make("SGCThreeRods-v0")
+    env = gym.make("SGCThreeRods-v1")
     record = run_episode(SGCExpert(env), env, seed=0, keep_infos=True)
     scenario = env.unwrapped.scenario
     env.close()
@@ -162,7 +162,7 @@ def test_gif_delays_add_up_to_real_time():
 
 
 def test_pierced_balls_ride_their_rods():
-    env = gym.make("SGCThreeRods-v0")
+    env = gym.make("SGCThreeRods-v1")
     _, info = env.reset(seed=0)
     base = env.unwrapped
     scene = DemoScene(base.scenario)

@@ -103,14 +103,14 @@ def test_expert_rejects_a_wrong_observation():
 
 
 def test_without_the_torque_correction_goals_stay_exact():
-    env = gym.make("SGCThreeRods-v0")
+    env = gym.make("SGCThreeRods-v1")
     record = run_episode(SGCExpert(env, refine=False), env, seed=7, keep_infos=True)
     env.close()
-    _assert_exact(record, "SGCThreeRods-v0")
+    _assert_exact(record, "SGCThreeRods-v1")
 
 
 def test_actions_from_tuples_equal_actions_from_arrays():
-    env = gym.make("SGCThreeRods-v0")
+    env = gym.make("SGCThreeRods-v1")
     model = SGCExpert(env).model
     env.close()
     rng = np.random.default_rng(0)

@@ -10,7 +10,7 @@ import sgc_env  # noqa: F401  (registers the ids)
 from baselines.expert import SGCExpert
 from sgc_env.envs import SGCEnv
 
-WATCHED = ("SGCRod-v0", "SGCThreeRods-v0", "SGCIntercept-v0")
+WATCHED = ("SGCRod-v0", "SGCThreeRods-v1", "SGCIntercept-v0")
 
 
 def _largest_colour_share(frame: np.ndarray) -> float:
@@ -64,7 +64,7 @@ def test_every_body_stays_in_frame_of_the_fixed_camera(env_id):
 
 
 def test_tracking_camera_follows_the_bodies():
-    frames = _expert_positions("SGCThreeRods-v0", camera="tracking")
+    frames = _expert_positions("SGCThreeRods-v1", camera="tracking")
     looks = {view.orbit[0] for view, _ in frames}
     assert len(looks) > len(frames) // 2  # it moves
     for view, positions in frames:

@@ -100,7 +100,7 @@ def test_orientation_track_and_several_bodies() -> None:
     feats = _features(extractor, obs)
     assert feats[2 * TRACK_FEATURES - 2] == 1.0  # the rod has an orientation track
     env.close()
-    three = gym.make("SGCThreeRods-v0")
+    three = gym.make("SGCThreeRods-v1")
     assert ScheduleFeatures(three.observation_space).features_dim == 3 * (2 * TRACK_FEATURES + 1)
     with pytest.raises(ValueError, match="gravity: expected 3 values"):
         ScheduleFeatures(three.observation_space, gravity=[0.1, 0.1])

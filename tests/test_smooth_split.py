@@ -122,8 +122,8 @@ def _kink_rows(episodes: int) -> list[dict]:
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    rows = module.compare("SGCThreeRods-v0", 1, 0, "expert")
-    return rows + module.compare("SGCThreeRodsRandom-v0", episodes, 10000, "expert")
+    rows = module.compare("SGCThreeRods-v1", 1, 0, "expert")
+    return rows + module.compare("SGCThreeRodsRandom-v1", episodes, 10000, "expert")
 
 
 @pytest.mark.slow

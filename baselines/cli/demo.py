@@ -1,6 +1,6 @@
 """The paper's three-rod demo, run by the expert and written out as a viewer would want it.
 
-One episode of ``SGCThreeRods-v0`` driven by :class:`baselines.SGCExpert` (the tangent
+One episode of ``SGCThreeRods-v1`` driven by :class:`baselines.SGCExpert` (the tangent
 end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``), scored by
 the shared harness, and rendered headless through the renderer of ``env.render()``
 (:mod:`sgc_env.render`: TinyRenderer for the bodies, then sky, checkered floor, shadows,
@@ -32,7 +32,7 @@ from sgc_env.simulator import pybullet
 
 __all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
 
-ENV_ID = "SGCThreeRods-v0"
+ENV_ID = "SGCThreeRods-v1"
 PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
 """Moments the plates show: launch, piercing, flight, somersault, the hits, all three in."""
 ROD_DRAW_RADIUS = 0.075
