@@ -21,9 +21,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BodyHandle", "BodyState", "Drive", "Simulator", "connected_clients", "pybullet"]
+__all__ = ["BodyHandle", "BodyReading", "Drive", "Simulator", "connected_clients", "pybullet"]
 
-BodyState = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]
+BodyReading = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...], tuple[float, ...]]
 """One body as read back: position, quaternion xyzw, linear and angular velocity (world)."""
 
 Drive = tuple[int, Sequence[float], Sequence[float] | None, Sequence[Sequence[float]]]
@@ -207,7 +207,7 @@ class Simulator:
         pybullet.resetBasePositionAndOrientation(uid, position, orientation, physicsClientId=c)
         pybullet.resetBaseVelocity(uid, linear_velocity, angular_velocity, physicsClientId=c)
 
-    def body_states(self, uids: Sequence[int]) -> list[BodyState]:
+    def body_states(self, uids: Sequence[int]) -> list[BodyReading]:
         """(position, orientation, linear velocity, angular velocity) per body, one read each."""
         get_pose, get_velocity = self._get_pose, self._get_velocity
         c = self.client

@@ -18,7 +18,7 @@ import numpy as np
 
 from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.scenario import Scenario
-from sgc_env.simulator import BodyState, Drive, Simulator
+from sgc_env.simulator import BodyReading, Drive, Simulator
 
 __all__ = ["Actuation", "clip_action"]
 
@@ -79,7 +79,7 @@ class Actuation:
         """The applied wrench record before any step (forces then torques, zeros)."""
 
     def drives(
-        self, values: Sequence[float], states: Sequence[BodyState]
+        self, values: Sequence[float], states: Sequence[BodyReading]
     ) -> tuple[list[Drive], list[float]]:
         """The drives of one control period and the applied forces then torques (flat)."""
         use_torque = self.use_torque
@@ -114,7 +114,7 @@ class Actuation:
         return drives, applied_f + (applied_t or self._zeros3n)
 
     def impulse(
-        self, i: int, state: BodyState, linear: np.ndarray, angular: np.ndarray
+        self, i: int, state: BodyReading, linear: np.ndarray, angular: np.ndarray
     ) -> tuple[list[float], list[float]]:
         """Body ``i``'s velocities after an impulse (N s) and angular impulse (N m s, world
         frame, about the centre of mass): ``v + p / m``, ``w + R I^-1 R^T L``."""

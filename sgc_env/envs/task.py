@@ -26,12 +26,12 @@ from sgc_env.paper.quaternion import log as rotvec_from_quat
 from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
 from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
-from sgc_env.simulator import BodyState
+from sgc_env.simulator import BodyReading
 
 from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
-    "BodyState",
+    "BodyReading",
     "GoalEvent",
     "GoalTask",
     "RewardFunction",
@@ -111,17 +111,13 @@ class GoalTask:
     task (the env owns the reward: this module never picks one). After
     :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
     tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
-    (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`;
-    and :attr:`scaled_deviation`, ``sum_b |D_b| / L_b + |phi_b| / A_b`` with the current course's
-    scales (:attr:`position_scale` = 1 / L, :attr:`orientation_scale` = 1 / A).
+    (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`.
     """
 
-    def __init__(self, scenario: Scenario, *, scales: tuple = (0.1, 0.5)) -> None:
-        """``scales``: the floors (m, rad) of the per-course normalisers L and A."""
+    def __init__(self, scenario: Scenario) -> None:
         self.tracks: list[BodyTracks] = compile_tracks(scenario)
         self.n_bodies = len(self.tracks)
         self.dt = 1.0 / scenario.control_frequency
-        self._min_length, self._min_angle = scales
         self.has_position = [bt.position is not None for bt in self.tracks]
         self.has_orientation = [bt.orientation is not None for bt in self.tracks]
         n = self.n_bodies
@@ -133,15 +129,12 @@ class GoalTask:
         self.orientation_goal_time = [0.0] * n
         self.position_course: list[tuple[float, ...]] = [()] * n
         self.orientation_course: list[tuple[float, ...]] = [()] * n
-        self.position_scale = [0.0] * n
-        self.orientation_scale = [0.0] * n
         self.goal_index = np.full(n, -1)
         self.orientation_goal_index = np.full(n, -1)
         self.points: list[tuple[float, ...]] = []
         self.deviations: list[tuple[float, ...]] = []
         self.position_time_left: list[float] = []
         self.orientation_time_left: list[float] = []
-        self.scaled_deviation = 0.0
         self.time = 0.0
         self.reset()
 
@@ -187,8 +180,6 @@ class GoalTask:
             self.nails[i] = tuple(tr.targets[k].tolist())
             self.position_goal_time[i] = float(tr.times[k])
             self.position_course[i] = _course_fields(tr, k)
-            course = float(np.linalg.norm(tr.course_start[k]))
-            self.position_scale[i] = 1.0 / max(course, self._min_length)
             self.goal_index = _with(self.goal_index, i, int(tr.goal_ids[k]))
         else:
             self.offsets[i] = _ZERO3
@@ -200,8 +191,6 @@ class GoalTask:
             self.goal_quaternions[i] = tuple(to.targets[k].tolist())
             self.orientation_goal_time[i] = float(to.times[k])
             self.orientation_course[i] = _course_fields(to, k)
-            course = float(np.linalg.norm(to.course_start[k]))
-            self.orientation_scale[i] = 1.0 / max(course, self._min_angle)
             self.orientation_goal_index = _with(self.orientation_goal_index, i, int(to.goal_ids[k]))
         else:
             self.orientation_course[i] = _ZERO13
@@ -219,7 +208,7 @@ class GoalTask:
 
     # ---------------------------------------------------------------- per step
 
-    def measure(self, states: Sequence[BodyState], time: float) -> None:
+    def measure(self, states: Sequence[BodyReading], time: float) -> None:
         """Deviations of every body from its current goals at ``time`` (see the class)."""
         offsets, nails, phis = self.offsets, self.nails, self.phi
         has_pos, has_ori = self.has_position, self.has_orientation
@@ -228,12 +217,10 @@ class GoalTask:
             self.orientation_goal_time,
             self.goal_quaternions,
         )
-        pscale, oscale = self.position_scale, self.orientation_scale
         points = []
         deviations: list[tuple[float, ...]] = []
         ptls = []
         otls = []
-        cost = 0.0
         for i, (pos, orn, lin, ang) in enumerate(states):
             offset = offsets[i]
             if offset == _ZERO3:
@@ -253,7 +240,6 @@ class GoalTask:
                     )
                 )  # fmt: skip
                 ptls.append(ptime[i] - time)
-                cost += math.sqrt(dx * dx + dy * dy + dz * dz) * pscale[i]
             else:
                 deviations.append(_ZERO6)
                 ptls.append(0.0)
@@ -261,14 +247,12 @@ class GoalTask:
                 phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, goal_q[i])), phis[i])
                 phis[i] = phi
                 otls.append(otime[i] - time)
-                cost += math.sqrt(phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) * oscale[i]
             else:
                 otls.append(0.0)
         self.points = points
         self.deviations = deviations
         self.position_time_left = ptls
         self.orientation_time_left = otls
-        self.scaled_deviation = cost
         self.time = time
 
     def advance(self, tick: int) -> tuple[list[GoalEvent], bool]:
