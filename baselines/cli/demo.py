@@ -344,9 +344,7 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
 def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
 
-    mp4 = options.out / "three_rods.mp4"
-    imageio.mimwrite(mp4, list[Any](frames), fps=VIDEO_FPS, codec="libx264", quality=7,
-                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
+    mp4 = write_mp4(options.out / "three_rods.mp4", frames)
     gif = options.out / "three_rods.gif"
     step = options.gif_scale
     small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)
@@ -355,6 +353,15 @@ def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict
     plates = options.out / "plates.png"
     imageio.imwrite(plates, plate_sheet(frames, times))
     return {"three_rods.mp4": mp4, "three_rods.gif": gif, "plates.png": plates}
+
+
+def write_mp4(path: Path, frames: Sequence[np.ndarray]) -> Path:
+    """``frames`` as an H.264 MP4 at :data:`VIDEO_FPS` (real time); ``path``."""
+    import imageio.v2 as imageio
+
+    imageio.mimwrite(path, list[Any](frames), fps=VIDEO_FPS, codec="libx264", quality=7,
+                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
+    return path
 
 
 def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:

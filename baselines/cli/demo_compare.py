@@ -13,7 +13,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from baselines.cli.demo import VIDEO_FPS, DemoResult
+from baselines.cli.demo import DemoResult, write_mp4
 
 __all__ = ["COMPARE_VIDEO", "side_by_side", "write_side_by_side"]
 
@@ -53,11 +53,5 @@ def side_by_side(left: DemoResult, right: DemoResult) -> list[np.ndarray]:
 
 
 def write_side_by_side(left: DemoResult, right: DemoResult, out: Path) -> Path:
-    """Write :func:`side_by_side` as an MP4 at the demo's frame rate; its path."""
-    import imageio.v2 as imageio
-
-    path = out / COMPARE_VIDEO
-    frames = side_by_side(left, right)
-    imageio.mimwrite(path, frames, fps=VIDEO_FPS, codec="libx264", quality=7,
-                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
-    return path
+    """Write :func:`side_by_side` as an MP4 at the demo's frame rate (real time); its path."""
+    return write_mp4(out / COMPARE_VIDEO, side_by_side(left, right))

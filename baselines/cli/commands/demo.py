@@ -23,7 +23,6 @@ import argparse
 import sys
 import time
 from pathlib import Path
-
 from typing import Any
 
 from baselines.cli.checks import (
@@ -128,8 +127,7 @@ def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int
             option = dataclasses.replace(option, out=stage / label if compare else stage)
             # the registry's episode length is the demo's tick count, known before the env is built
             task = bar.add_task(label, total=gym.spec(ENV_ID).max_episode_steps)
-            results.append(run_demo(option, lambda done, n, t=task: bar.update(
-                t, completed=done, total=n)))  # fmt: skip
+            results.append(run_demo(option, _ticker(bar, task)))
         files = [path for result in results for path in result.files.values()]
         if compare:
             files.append(write_side_by_side(results[0], results[1], stage))
@@ -156,6 +154,15 @@ def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int
         for o, r in zip(options, results, strict=True) if o.policy == "expert"
     )  # fmt: skip
     return 1 if missed else 0
+
+
+def _ticker(bar: Any, task: Any) -> Any:
+    """``progress(done, total)`` for :func:`run_demo` that moves ``task`` of ``bar``."""
+
+    def tick(done: int, total: int) -> None:
+        bar.update(task, completed=done, total=total)
+
+    return tick
 
 
 def scorecard_table(option: Any, result: Any) -> Any:
