@@ -35,8 +35,8 @@ from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
 
 __all__ = [
-    "DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "pierce_times",
-    "run_demo",
+    "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_policy",
+    "gif_durations", "pierce_times", "run_demo",
 ]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v1"
@@ -191,6 +191,17 @@ def demo_policy(options: DemoOptions, env: Any) -> Any:
     if options.policy == "expert":  # as before --policy existed: the same outputs, bit for bit
         return SGCExpert(env, end_rule=options.end_rule)
     return make_policy(options.policy, env, seed=0, trust_model=options.trust_model)
+
+
+def check_policy(options: DemoOptions) -> None:
+    """Raise :func:`demo_policy`'s ValueError now, before any output or progress bar."""
+    import gymnasium as gym
+
+    env = gym.make(ENV_ID)
+    try:
+        demo_policy(options, env)
+    finally:
+        env.close()
 
 
 def run_demo(

@@ -80,7 +80,7 @@ def _specs(args: argparse.Namespace) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     import sgc_env  # noqa: F401  (registers the ids)
-    from baselines.cli.demo import DemoOptions
+    from baselines.cli.demo import DemoOptions, check_policy
     from baselines.policies import policy_labels
 
     try:
@@ -96,6 +96,8 @@ def run(args: argparse.Namespace) -> int:
             )  # fmt: skip
             for spec in specs
         ]
+        for option in options:  # a spec or model that does not fit fails here, on one line
+            check_policy(option)
         return _fly(args, options, labels)
     except ValueError as exc:
         print(f"sgc demo: error: {exc}", file=sys.stderr)
