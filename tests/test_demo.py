@@ -204,6 +204,7 @@ def test_demo_compare_writes_both_runs_side_by_side(tmp_path, capsys):
     [
         (["--policy", "nonsense"], "unknown spec 'nonsense'"),
         (["--policy", str(ROD_MODEL)], "does not fit"),
+        (["--policy", "shipped:SGCPoint-v0"], "(trained on SGCPoint-v0)"),
         (["--policy", "random", "--paper-rule"], "--paper-rule: applies to the expert"),
         (["--compare", "expert"], "expected two specs"),
         (["--compare", "expert,random", "--no-video"], "drop --no-video"),
