@@ -91,6 +91,7 @@ def main() -> None:
     from baselines.cli.demo_camera import camera_at
     from baselines.expert import SGCExpert
     from sgc_env.render import Painter, Trail
+    from sgc_env.scenes import three_rods
     from sgc_env.simulator import pybullet as pb
 
     def per_frame(call) -> float:
@@ -106,7 +107,8 @@ def main() -> None:
     env = gym.make("SGCThreeRods-v1")
     _, info = env.reset(seed=0)
     base: Any = env.unwrapped  # the SGCEnv
-    scene = DemoScene(base.scenario)
+    pierced = [three_rods.PIERCE_TIME] * len(base.scenario.bodies)  # as the expert pierces
+    scene = DemoScene(base.scenario, pierced)
     client = scene.client
     casters = scene.update(2.0, info["body_position"], info["body_orientation"])
     view = camera_at(2.0, w, h)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 import yaml
 
 import sgc_env
-from baselines.cli.demo import DemoOptions, DemoScene, gif_durations
+from baselines.cli.demo import DemoOptions, DemoScene, gif_durations, pierce_times
 from baselines.cli.demo_camera import DEMO_SHOTS, camera_at
 from baselines.cli.main import main
 from baselines.evaluation import run_episode
@@ -20,6 +21,13 @@ from sgc_env.scenario.load import builtin_path
 from sgc_env.scenes import three_rods
 from sgc_env.simulator import pybullet
 
+ROD_MODEL = Path(__file__).resolve().parents[1] / "baselines/checkpoints/ppo_dagger_SGCRod-v0.zip"
+"""A shipped model of the one-rod env (6 actions): it does not fit the three rods (18)."""
+OUTPUTS = {
+    "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png", "goals.csv",
+    "summary.json", "rods.json",
+}  # fmt: skip
+"""What one run of ``sgc demo`` writes, whichever policy flies it."""
 MIN_SPEED_FRACTION = 0.1
 """A rod 'never stops': its tip speed stays above this fraction of its mean flight speed."""
 
@@ -131,11 +139,7 @@ def test_demo_command_writes_every_output(tmp_path, capsys):
     out = tmp_path / "demo"
     code = main(["demo", "--out", str(out), "--width", "96", "--height", "64"])
     assert code == 0
-    expected = {
-        "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png",
-        "goals.csv", "summary.json", "rods.json",
-    }  # fmt: skip
-    assert expected <= {p.name for p in out.iterdir()}
+    assert OUTPUTS <= {p.name for p in out.iterdir()}
     rods = json.loads((out / "rods.json").read_text())
     assert [r["goals"] for r in rods] == [25, 16, 17]
     assert all(r["position_error_max_m"] <= 1e-9 for r in rods)
@@ -151,6 +155,71 @@ def test_demo_can_show_the_papers_rule(tmp_path, capsys):
     assert json.loads((out / "summary.json").read_text())["position_error_max"] <= 1e-9
 
 
+def test_demo_flies_another_policy_with_the_same_outputs(tmp_path, capsys):
+    out = tmp_path / "random"
+    code = main(["demo", "--policy", "random", "--out", str(out), "--width", "64",
+                 "--height", "48"])  # fmt: skip
+    assert code == 0  # a policy that misses goals is reported, not an error
+    assert OUTPUTS <= {p.name for p in out.iterdir()}
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["goals_met"] < 58
+    assert {row.split(",")[1] for row in (out / "goals.csv").read_text().splitlines()[1:]} == {
+        "random"
+    }
+    printed = capsys.readouterr().out
+    assert "policy random, scored by the harness" in printed
+    assert f"random: {summary['goals_met']}/58 goals met" in printed
+
+
+def test_demo_compare_writes_both_runs_side_by_side(tmp_path, capsys):
+    import imageio.v2 as imageio
+
+    out = tmp_path / "compare"
+    code = main(["demo", "--compare", "expert,random", "--out", str(out), "--width", "64",
+                 "--height", "48"])  # fmt: skip
+    assert code == 0
+    summaries = json.loads((out / "summary.json").read_text())
+    assert set(summaries) == {"expert", "random"}
+    assert summaries["expert"]["goals_met"] == 58 > summaries["random"]["goals_met"]
+    expert = imageio.mimread(out / "expert" / "three_rods.mp4", memtest=False)
+    rand = imageio.mimread(out / "random" / "three_rods.mp4", memtest=False)
+    both = imageio.mimread(out / "compare.mp4", memtest=False)
+    assert (out / "random" / "plates.png").exists()
+    assert both[0].shape == (48, 128, 3) and expert[0].shape == (48, 64, 3)
+    assert len(both) == len(expert) > len(rand)  # random ended early: its last frame is held
+
+    def gap(a, b):  # below the caption band, H.264 noise of a few levels
+        return np.abs(a[30:].astype(int) - b[30:].astype(int)).mean()
+
+    for i in (len(both) // 2, len(both) - 1):
+        left, right = both[i][:, :64], both[i][:, 64:]
+        assert gap(left, expert[i]) < 8.0 < gap(left, rand[-1])
+        assert gap(right, rand[-1]) < 8.0 < gap(right, expert[i])
+    printed = capsys.readouterr().out
+    assert "the expert (the tangent rule)" in printed and "policy random" in printed
+
+
+@pytest.mark.parametrize(
+    ("argv", "problem"),
+    [
+        (["--policy", "nonsense"], "unknown spec 'nonsense'"),
+        (["--policy", str(ROD_MODEL)], "does not fit"),
+        (["--policy", "shipped:SGCPoint-v0"], "(trained on SGCPoint-v0)"),
+        (["--policy", "random", "--paper-rule"], "--paper-rule: applies to the expert"),
+        (["--compare", "expert"], "expected two specs"),
+        (["--compare", "expert,random", "--no-video"], "drop --no-video"),
+    ],
+)
+def test_demo_bad_policy_exits_2_with_one_line(argv, problem, tmp_path, capsys):
+    out = tmp_path / "demo"
+    extra = [] if "--no-video" in argv else ["--no-video"]
+    assert main(["demo", *argv, "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("sgc demo: error:") and err.count("\n") == 1, err
+    assert problem in err
+    assert not out.exists() or not any(out.iterdir())
+
+
 def test_gif_delays_add_up_to_real_time():
     """GIF delays are whole centiseconds: 15 fps needs 70, 70, 60 ms, never all 60 or 70."""
     durations = gif_durations(130, 15.0)
@@ -161,11 +230,31 @@ def test_gif_delays_add_up_to_real_time():
     assert set(durations) == {60, 70}
 
 
-def test_pierced_balls_ride_their_rods():
+def test_expert_pierces_every_ball_on_the_pierce_tick(episode):
+    record, scenario = episode
+    times, tips = _tips(record)
+    assert pierce_times(scenario, times, tips) == [three_rods.PIERCE_TIME] * 3
+
+
+def test_a_ball_the_tip_never_meets_is_not_pierced(episode):
+    record, scenario = episode
+    times, tips = _tips(record)
+    moved = tips.copy()
+    moved[:, 1] += np.array([0.0, 0.0, 0.5])  # teal's tip passes 0.5 m above its 0.22 m ball
+    pierced = pierce_times(scenario, times, moved)
+    assert pierced[1] is None and pierced[0] == pierced[2] == three_rods.PIERCE_TIME
+    late = tips.copy()
+    late[times < 2.0, 2] = 100.0  # violet only ever meets its ball after 2 s: none left by then
+    assert pierce_times(scenario, times, late)[2] is None
+
+
+def test_pierced_balls_ride_their_rods_and_missed_ones_fly_on():
     env = gym.make("SGCThreeRods-v1")
     _, info = env.reset(seed=0)
     base = env.unwrapped
-    scene = DemoScene(base.scenario)
+    with pytest.raises(ValueError, match="one time per rod"):
+        DemoScene(base.scenario, [1.0])
+    scene = DemoScene(base.scenario, [three_rods.PIERCE_TIME, three_rods.PIERCE_TIME, None])
     client = scene.client
     positions, orientations = info["body_position"], info["body_orientation"]
     before = three_rods.PIERCE_TIME - 0.5
@@ -174,11 +263,14 @@ def test_pierced_balls_ride_their_rods():
     for ball, uid in zip(balls, scene.ball_uids, strict=True):
         at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
         np.testing.assert_allclose(at, ball.position_at(before), atol=1e-12)
-    scene.update(three_rods.PIERCE_TIME + 1.0, positions, orientations)  # slid to the middle
-    for rod, uid in zip(scene.rods, scene.ball_uids, strict=True):
+    later = three_rods.PIERCE_TIME + 1.0
+    scene.update(later, positions, orientations)  # slid to the middle
+    for rod, uid in zip(scene.rods[:2], scene.ball_uids[:2], strict=True):
         centre = pybullet.getBasePositionAndOrientation(rod, physicsClientId=client)[0]
         at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
         np.testing.assert_allclose(at, centre, atol=1e-12)
+    at = pybullet.getBasePositionAndOrientation(scene.ball_uids[2], physicsClientId=client)[0]
+    np.testing.assert_allclose(at, balls[2].position_at(later), atol=1e-12)  # never met
     scene.close()
     env.close()
 

@@ -1,9 +1,10 @@
 """Issue 25: model files from elsewhere run no code; malformed ones get a clear error, exit 2.
 
 Each payload below is real: loaded the way SB3 and pickle load by default (``--trust-model``)
-it runs a shell command that creates a marker file. The tests show that ``sgc evaluate`` and
-``sgc rollout`` never create it without that flag, and either load the model safely or refuse
-naming the file. (``sgc demo`` has no ``--policy`` yet; it runs the expert only.)
+it runs a shell command that creates a marker file. The tests show that ``sgc evaluate``,
+``sgc rollout`` and ``sgc demo --policy`` never create it without that flag, and either load
+the model safely or refuse naming the file. The demo's models are built on the three-rod env's
+spaces, so that its safe path really loads them and flies the demo.
 """
 
 from __future__ import annotations
@@ -38,10 +39,10 @@ class Payload:
         return (os.system, (f"touch '{self.marker}'",))
 
 
-def _clean_model(path: Path) -> Path:
+def _clean_model(path: Path, env_id: str = "SGCPoint-v0") -> Path:
     from stable_baselines3 import PPO
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make(env_id)
     PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu",
         policy_kwargs={"net_arch": [8]}).save(path)  # fmt: skip
     env.close()
@@ -89,18 +90,37 @@ def _rollout(policy: Path, tmp: Path, *extra: str) -> int:
                      "--out", str(tmp / "ro"), *extra])  # fmt: skip
 
 
-COMMANDS = {"evaluate": _evaluate, "rollout": _rollout}
+def _demo(policy: Path, tmp: Path, *extra: str) -> int:
+    return cli.main(["demo", "--policy", str(policy), "--no-video", "--out", str(tmp / "demo"),
+                     *extra])  # fmt: skip
+
+
+COMMANDS = {"evaluate": _evaluate, "rollout": _rollout, "demo": _demo}
 
 
 @pytest.fixture(scope="module")
-def clean(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _clean_model(tmp_path_factory.mktemp("clean") / "model.zip")
+def clean_models(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """A clean model per env the commands run on: the point for evaluate and rollout, the
+    three rods for the demo."""
+    folder = tmp_path_factory.mktemp("clean")
+    return {"SGCPoint-v0": _clean_model(folder / "model.zip"),
+            "SGCThreeRods-v1": _clean_model(folder / "rods.zip", "SGCThreeRods-v1")}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def clean(clean_models: dict[str, Path]) -> Path:
+    return clean_models["SGCPoint-v0"]
+
+
+def _clean_for(command: str, clean_models: dict[str, Path]) -> Path:
+    return clean_models["SGCThreeRods-v1" if command == "demo" else "SGCPoint-v0"]
 
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_pickled_field_in_the_zip_runs_nothing_and_the_model_loads_safely(
-    command: str, clean: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+    command: str, clean_models: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
+    clean = _clean_for(command, clean_models)
     marker = tmp_path / "pwned"
     evil = _pickled_field_model(clean, tmp_path / "evil.zip", marker)
     assert COMMANDS[command](evil, tmp_path) == 0  # rebuilt from the JSON, nothing unpickled
@@ -113,8 +133,9 @@ def test_pickled_field_in_the_zip_runs_nothing_and_the_model_loads_safely(
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_pickled_statistics_beside_a_clean_model_are_refused(
-    command: str, clean: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+    command: str, clean_models: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
+    clean = _clean_for(command, clean_models)
     marker = tmp_path / "pwned"
     model = tmp_path / "m.zip"
     model.write_bytes(clean.read_bytes())
@@ -130,8 +151,9 @@ def test_pickled_statistics_beside_a_clean_model_are_refused(
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_pickled_weights_are_refused_by_weights_only(
-    command: str, clean: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+    command: str, clean_models: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
+    clean = _clean_for(command, clean_models)
     marker = tmp_path / "pwned"
     evil = _pickled_weights_model(clean, tmp_path / "evil.zip", marker)
     assert COMMANDS[command](evil, tmp_path) == 2
@@ -241,3 +263,15 @@ def test_shipped_models_hold_no_pickle_beside_them() -> None:
     assert sorted(p.name for p in SHIPPED.glob("*.vecnormalize.json")) == [
         "ppo_schedule_SGCPoint-v0.vecnormalize.json", "ppo_schedule_SGCRod-v0.vecnormalize.json",
     ]  # fmt: skip
+
+
+def test_demo_refuses_a_model_of_other_spaces_before_unpickling(
+    clean: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    marker = tmp_path / "pwned"
+    evil = _pickled_field_model(clean, tmp_path / "evil.zip", marker)  # the point's 3 actions
+    assert _demo(evil, tmp_path) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("sgc demo: error:") and err.count("\n") == 1, err
+    assert "does not fit" in err and "evil" in err
+    assert not marker.exists() and not (tmp_path / "demo").exists()

@@ -1,12 +1,16 @@
-"""The paper's three-rod demo, run by the expert and written out as a viewer would want it.
+"""The paper's three-rod demo, flown by a policy and written out as a viewer would want it.
 
 One episode of ``SGCThreeRods-v1`` driven by :class:`baselines.SGCExpert` (the tangent
-end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``), scored by
+end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``) or by any
+policy spec :func:`baselines.policies.make_policy` accepts (``DemoOptions.policy``), scored by
 the shared harness, and rendered headless through the renderer of ``env.render()``
 (:mod:`sgc_env.render`: TinyRenderer for the bodies, then sky, checkered floor, shadows,
 fading trails, nails) from the cameras of :mod:`baselines.cli.demo_camera`. Rods are drawn
-thicker than their physical radius, and each red ball, once pierced, rides on its rod into the
-target (visual only: the render world is a client of its own, physics is untouched).
+thicker than their physical radius, and each red ball that its rod's tip really met (came
+within the ball's radius of its centre, :func:`pierce_times`) rides on that rod from the tick
+of closest approach on; a ball never met flies on along its own path (visual only: the render
+world is a client of its own, physics is untouched). The episode runs first and is drawn
+afterwards, so that the pierce is known when the frames are drawn.
 Outputs: an MP4 and a GIF at real time, an
 8-frame plate sheet in the spirit of the paper's Plates 1-8, deviation and speed plots per rod
 (named and coloured as in the video), ``goals.csv``, ``summary.json`` and ``rods.json``.
@@ -30,7 +34,10 @@ from sgc_env.paper.end_rules import END_RULES
 from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
 
-__all__ = ["DemoOptions", "DemoResult", "DemoScene", "cpu_seconds", "gif_durations", "run_demo"]
+__all__ = [
+    "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_policy",
+    "gif_durations", "pierce_times", "run_demo",
+]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v1"
 PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
@@ -44,7 +51,9 @@ VIDEO_FPS = 30
 
 @dataclass(frozen=True)
 class DemoOptions:
-    """What to run and render. ``end_rule``: the expert's end-velocity rule."""
+    """What to run and render. ``policy``: a spec of :func:`baselines.policies.make_policy`;
+    ``end_rule``: the expert's end-velocity rule (for ``policy="expert"`` only);
+    ``trust_model``: unpickle model files (``--trust-model``)."""
 
     out: Path
     width: int = 960
@@ -52,6 +61,8 @@ class DemoOptions:
     gif_scale: int = 2
     video: bool = True
     end_rule: str = "tangent"
+    policy: str = "expert"
+    trust_model: bool = False
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "gif_scale"):
@@ -60,16 +71,36 @@ class DemoOptions:
                 raise ValueError(f"{name}: expected a positive integer, got {value!r}")
         if self.end_rule not in END_RULES:
             raise ValueError(f"end_rule: expected one of {END_RULES}, got {self.end_rule!r}")
+        if not isinstance(self.policy, str) or not self.policy:
+            raise ValueError(f"policy: expected a non-empty spec, got {self.policy!r}")
+        if self.end_rule != "tangent" and self.policy != "expert":
+            raise ValueError(
+                f"end_rule: applies to the expert only, not to policy {self.policy!r} "
+                "(for the paper's rule use policy 'expert-paper')"
+            )
+
+    @property
+    def label(self) -> str:
+        """The policy's name in tables, panels and ``goals.csv``."""
+        if self.policy == "expert":
+            return "expert" if self.end_rule == "tangent" else "expert-paper"
+        from baselines.policies import policy_label
+
+        return policy_label(self.policy)
 
 
 @dataclass
 class DemoResult:
-    """Where everything went, the scorecard, and the CPU seconds the run took."""
+    """Where everything went, the scorecard, the CPU seconds the run took, and the video's
+    frames with their times (for ``sgc demo --compare``)."""
 
     files: dict[str, Path] = field(default_factory=dict)
     summary: dict[str, Any] = field(default_factory=dict)
     per_rod: list[dict[str, Any]] = field(default_factory=list)
     cpu_s: float = 0.0
+    label: str = "expert"
+    frames: list[np.ndarray] = field(default_factory=list)
+    frame_times: list[float] = field(default_factory=list)
 
 
 _AT_IMPORT = os.times()
@@ -85,44 +116,99 @@ def cpu_seconds() -> float:
     return t.user + t.system + t.children_user + t.children_system - _EARLIER_CHILDREN
 
 
+def ball_indices(scenario: Any) -> list[int]:
+    """Index in ``scenario.props`` of each rod's red ball (``rod_gold`` -> ``ball_gold``)."""
+    names = [p.name for p in scenario.props]
+    return [names.index(f"ball_{b.name[4:]}") for b in scenario.bodies]
+
+
+def pierce_times(
+    scenario: Any, times: Sequence[float], tips: np.ndarray
+) -> list[float | None]:
+    """When each rod pierced its ball: None if its tip never came within the ball's radius of
+    the ball's centre, else the tick of closest approach within the first such contact.
+
+    ``tips``: (ticks, rods, 3) tip positions at ``times``. The expert meets each ball's centre
+    on the tick of the pierce goal (1.2 s), so its balls are carried from exactly then."""
+    out: list[float | None] = []
+    for b, k in enumerate(ball_indices(scenario)):
+        ball = scenario.props[k]
+        distance = np.array([np.linalg.norm(tips[i, b] - ball.position_at(t))
+                             for i, t in enumerate(times)])  # fmt: skip
+        inside = distance <= ball.size[0]
+        if not inside.any():
+            out.append(None)
+            continue
+        first = int(np.argmax(inside))
+        last = first + int(np.argmin(inside[first:])) if not inside[first:].all() else len(times)
+        out.append(float(times[first + int(np.argmin(distance[first:last]))]))
+    return out
+
+
 class DemoScene:
     """The demo's render world (thick rod shells, the bullseye board) with the pierced balls
-    carried on their rods."""
+    carried on their rods. ``pierce``: when each rod pierced its ball (None: never; see
+    :func:`pierce_times`)."""
 
-    def __init__(self, scenario: Any) -> None:
+    def __init__(self, scenario: Any, pierce: Sequence[float | None]) -> None:
         from sgc_env.scenes import three_rods
 
+        if len(pierce) != len(scenario.bodies):
+            raise ValueError(f"pierce: expected one time per rod, got {len(pierce)}")
         self.world = RenderWorld(scenario, ROD_DRAW_RADIUS)
         self.client = self.world.client
         self.props = scenario.props
-        ball_names = [f"ball_{b.name[4:]}" for b in scenario.bodies]
-        self.ball_index = [[p.name for p in scenario.props].index(n) for n in ball_names]
+        self.ball_index = ball_indices(scenario)
         self.ball_uids = [self.world.prop_uids[k] for k in self.ball_index]
         self.rods = self.world.body_uids
         self.tip = np.asarray(three_rods.TIP, float)
-        self.pierce_time = three_rods.PIERCE_TIME
+        self.pierce = list(pierce)
 
     def update(self, now: float, positions: Sequence[Sequence[float]],
                orientations: Sequence[Sequence[float]]) -> list[Caster]:  # fmt: skip
         """Pose rods (as the env has them) and props for time ``now``; the shadow casters."""
         props = [np.asarray(p.position_at(now), float) for p in self.props]
-        if now >= self.pierce_time:
-            slide = min((now - self.pierce_time) / BALL_SLIDE, 1.0)
+        for k, pierced, position, orientation in zip(self.ball_index, self.pierce, positions,
+                                                     orientations, strict=True):  # fmt: skip
+            if pierced is None or now < pierced:
+                continue
+            slide = min((now - pierced) / BALL_SLIDE, 1.0)
             along = self.tip * (1.0 - slide * slide * (3.0 - 2.0 * slide))
-            for k, position, orientation in zip(self.ball_index, positions, orientations,
-                                                strict=True):  # fmt: skip
-                axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
-                props[k] = np.asarray(position, float) + axis @ along
+            axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
+            props[k] = np.asarray(position, float) + axis @ along
         return self.world.update(positions, orientations, props)
 
     def close(self) -> None:
         self.world.close()
 
 
+def demo_policy(options: DemoOptions, env: Any) -> Any:
+    """The policy that flies the demo; a ValueError (exit 2 in the CLI) if the spec is unknown
+    or a model file does not fit the three-rod env (checked before anything is unpickled)."""
+    from baselines.expert import SGCExpert
+    from baselines.policies import make_policy
+
+    if options.policy == "expert":  # as before --policy existed: the same outputs, bit for bit
+        return SGCExpert(env, end_rule=options.end_rule)
+    return make_policy(options.policy, env, seed=0, trust_model=options.trust_model)
+
+
+def check_policy(options: DemoOptions) -> None:
+    """Raise :func:`demo_policy`'s ValueError now, before any output or progress bar."""
+    import gymnasium as gym
+
+    env = gym.make(ENV_ID)
+    try:
+        demo_policy(options, env)
+    finally:
+        env.close()
+
+
 def run_demo(
     options: DemoOptions, progress: Callable[[int, int], None] | None = None
 ) -> DemoResult:
-    """Run, score and render the demo; ``progress(done, total)`` is called every tick."""
+    """Run, score and render the demo; ``progress(done, total)`` is called every tick, of the
+    episode and then of the drawing (``total`` counts both)."""
     import gymnasium as gym
 
     from baselines.evaluation import (
@@ -132,47 +218,37 @@ def run_demo(
         write_goals_csv,
         write_summary_json,
     )
-    from baselines.expert import SGCExpert
 
     started = cpu_seconds()
-    options.out.mkdir(parents=True, exist_ok=True)
     env = gym.make(ENV_ID)
+    try:
+        policy = demo_policy(options, env)
+    except BaseException:
+        env.close()
+        raise
+    options.out.mkdir(parents=True, exist_ok=True)
     base: Any = env.unwrapped  # the SGCEnv: scenario, sim, max_steps
     scenario = base.scenario
-    total = base.max_steps
-    frame_every = round(base.control_frequency / VIDEO_FPS)
-    frames: list[Any] = []
-    frame_times: list[float] = []
-    tips: list[np.ndarray] = []
-    tip_times: list[float] = []
-    scene: Any = None
-    painter: Any = None
-    if options.video:
-        scene = DemoScene(scenario)
-        nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
-        painter = Painter(scene.client, [b.color for b in scenario.bodies], nails)
+    passes = 2 if options.video else 1
+    total = passes * base.max_steps
+    ticks: list[Mapping[str, Any]] = []
 
     def on_step(env_: Any, step: int, info: Mapping[str, Any]) -> None:
-        now = float(info.get("time", 0.0))
-        tips.append(np.asarray(info["point_position"], float))
-        tip_times.append(now)
-        if painter is not None and scene is not None and step % frame_every == 0:
-            casters = scene.update(now, info["body_position"], info["body_orientation"])
-            view = camera_at(now, options.width, options.height)
-            frames.append(painter.frame(view, _trails(tips, tip_times, now), casters, now))
-            frame_times.append(now)
+        ticks.append(info)
         if progress is not None:
             progress(step, total)
 
-    expert = SGCExpert(env, end_rule=options.end_rule)
-    record = run_episode(expert, env, seed=0, keep_infos=True, on_step=on_step)
-    env.close()
-    if scene is not None:
-        scene.close()
+    try:
+        record = run_episode(policy, env, seed=0, keep_infos=True, on_step=on_step)
+    finally:
+        env.close()
 
-    result = DemoResult()
-    label = "expert" if options.end_rule == "tangent" else "expert-paper"
-    rows = goal_rows(record, ENV_ID, label)
+    result = DemoResult(label=options.label)
+    if options.video:
+        drawn = None if progress is None else (lambda step: progress(base.max_steps + step, total))
+        frame_every = round(base.control_frequency / VIDEO_FPS)
+        result.frames, result.frame_times = _draw(scenario, ticks, options, frame_every, drawn)
+    rows = goal_rows(record, ENV_ID, result.label)
     result.summary = summarize([record], rows)
     result.files["goals.csv"] = write_goals_csv(rows, options.out / "goals.csv")
     result.files["summary.json"] = write_summary_json(result.summary, options.out / "summary.json")
@@ -181,10 +257,37 @@ def run_demo(
     per_rod_path.write_text(json.dumps(result.per_rod, indent=2))
     result.files["rods.json"] = per_rod_path
     result.files.update(_plots(record, scenario, options.out))
-    if frames:
-        result.files.update(_videos(frames, frame_times, options))
+    if result.frames:
+        result.files.update(_videos(result.frames, result.frame_times, options))
     result.cpu_s = cpu_seconds() - started
     return result
+
+
+def _draw(
+    scenario: Any, ticks: Sequence[Mapping[str, Any]], options: DemoOptions, frame_every: int,
+    progress: Callable[[int], None] | None,
+) -> tuple[list[np.ndarray], list[float]]:  # fmt: skip
+    """The video's frames (one every ``frame_every`` ticks) and their times."""
+    times = [float(info.get("time", 0.0)) for info in ticks]
+    tips = [np.asarray(info["point_position"], float) for info in ticks]
+    scene = DemoScene(scenario, pierce_times(scenario, times, np.stack(tips)))
+    nails = [np.array([g.nail for g in b.goals if g.nail is not None]) for b in scenario.bodies]
+    painter = Painter(scene.client, [b.color for b in scenario.bodies], nails)
+    frames: list[np.ndarray] = []
+    frame_times: list[float] = []
+    try:
+        for step, (now, info) in enumerate(zip(times, ticks, strict=True)):
+            if step % frame_every == 0:
+                casters = scene.update(now, info["body_position"], info["body_orientation"])
+                view = camera_at(now, options.width, options.height)
+                trails = _trails(tips[: step + 1], times[: step + 1], now)
+                frames.append(painter.frame(view, trails, casters, now))
+                frame_times.append(now)
+            if progress is not None:
+                progress(step)
+    finally:
+        scene.close()
+    return frames, frame_times
 
 
 def _trails(tips: list[np.ndarray], times: list[float], now: float) -> list[Trail]:
@@ -218,7 +321,7 @@ def _per_rod(
             {
                 "rod": body.name,
                 "goals": len(body.goals),
-                "position_error_max_m": max(position),
+                "position_error_max_m": max(position) if position else None,
                 "orientation_error_max_rad": max(orientation) if orientation else None,
                 "closest_approach_offset_max_s": max(offsets) if offsets else None,
                 "sparc_track": card.get("sparc_track"),
@@ -252,9 +355,7 @@ def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
 def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict[str, Path]:
     import imageio.v2 as imageio
 
-    mp4 = options.out / "three_rods.mp4"
-    imageio.mimwrite(mp4, list[Any](frames), fps=VIDEO_FPS, codec="libx264", quality=7,
-                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
+    mp4 = write_mp4(options.out / "three_rods.mp4", frames)
     gif = options.out / "three_rods.gif"
     step = options.gif_scale
     small = [cv2.resize(f, (f.shape[1] // step, f.shape[0] // step), interpolation=cv2.INTER_AREA)
@@ -263,6 +364,15 @@ def _videos(frames: list[Any], times: list[float], options: DemoOptions) -> dict
     plates = options.out / "plates.png"
     imageio.imwrite(plates, plate_sheet(frames, times))
     return {"three_rods.mp4": mp4, "three_rods.gif": gif, "plates.png": plates}
+
+
+def write_mp4(path: Path, frames: Sequence[np.ndarray]) -> Path:
+    """``frames`` as an H.264 MP4 at :data:`VIDEO_FPS` (real time); ``path``."""
+    import imageio.v2 as imageio
+
+    imageio.mimwrite(path, list[Any](frames), fps=VIDEO_FPS, codec="libx264", quality=7,
+                     macro_block_size=4, ffmpeg_params=["-preset", "veryfast"])  # fmt: skip
+    return path
 
 
 def plate_sheet(frames: Sequence[np.ndarray], times: Sequence[float]) -> np.ndarray:

@@ -1,10 +1,18 @@
-"""``sgc demo``: the paper's three-rod demo, run by the expert, rendered and scored.
+"""``sgc demo``: the paper's three-rod demo, flown by the expert or any policy, rendered and
+scored.
 
 Writes to ``--out`` (default ``runs/demo``): ``three_rods.mp4``, ``three_rods.gif``,
 ``plates.png`` (8 frames, like the paper's Plates 1-8), ``deviation.png`` and ``speed.png``
 (per rod), ``goals.csv`` (one row per goal), ``summary.json`` (the harness's scorecard) and
 ``rods.json`` (exactness, punctuality and smoothness per rod). ``--paper-rule`` runs the
-expert with the paper's k rules instead of the tangent rule. It prints the CPU time it took
+expert with the paper's k rules instead of the tangent rule. ``--policy SPEC`` flies any spec
+``sgc evaluate --policy`` takes (``minimum-jerk``, ``shipped:<stem>``, a model ``.zip``; model
+files load without unpickling unless ``--trust-model``) with the same outputs and scorecard.
+``--compare A,B`` (e.g. ``expert,minimum-jerk``) runs both, writes each run's outputs under
+``--out/<label>/``, the two side by side in ``compare.mp4`` (the runs' own frames), and both
+scorecards in ``summary.json`` (keyed by label). The exit status is 1 when the expert (alone
+or compared) misses a goal, 2 for bad input (an unknown spec, a model that does not fit the
+three-rod env), else 0. It prints the CPU time it took
 (``os.times``: this process since it started, plus waited-for children such as ffmpeg), the
 measure that matters on a shared machine, and the wall time.
 """
@@ -12,10 +20,18 @@ measure that matters on a shared machine, and the wall time.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
+from typing import Any
 
-from baselines.cli.checks import bounded_int, out_dir, staged_output
+from baselines.cli.checks import (
+    add_trust_argument,
+    bounded_int,
+    out_dir,
+    staged_output,
+    trust_model,
+)
 
 __all__ = ["add_arguments", "run"]
 
@@ -36,37 +52,131 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="end interior courses by the paper's k rules (eqs. 12-14) instead of the tangent "
         "rule",
     )  # fmt: skip
+    who = parser.add_mutually_exclusive_group()
+    who.add_argument(
+        "--policy", default="expert", metavar="SPEC",
+        help="the policy that flies the demo: expert | expert-paper | minimum-jerk | "
+        "dynamic-constraints | random | shipped:<stem> | SB3 .zip (default expert)",
+    )  # fmt: skip
+    who.add_argument(
+        "--compare", metavar="A,B", default=None,
+        help="fly two policies (e.g. expert,minimum-jerk) and write them side by side in "
+        "compare.mp4, with both scorecards",
+    )  # fmt: skip
+    add_trust_argument(parser)
+
+
+def _specs(args: argparse.Namespace) -> list[str]:
+    """The policies to fly, with ``--paper-rule`` applied to the expert."""
+    specs = [args.policy] if args.compare is None else [s.strip() for s in args.compare.split(",")]
+    if args.compare is not None and (len(specs) != 2 or not all(specs)):
+        raise ValueError(f"--compare: expected two specs A,B, got {args.compare!r}")
+    if args.compare is not None and args.no_video:
+        raise ValueError("--compare: draws the two runs side by side; drop --no-video")
+    if args.paper_rule and "expert" not in specs:
+        raise ValueError("--paper-rule: applies to the expert; use --policy expert-paper")
+    return specs
 
 
 def run(args: argparse.Namespace) -> int:
+    import sgc_env  # noqa: F401  (registers the ids)
+    from baselines.cli.demo import DemoOptions, check_policy
+    from baselines.policies import policy_labels
+
+    try:
+        specs = _specs(args)
+        labels = policy_labels(specs)
+        trust = trust_model(args, "demo")
+        options = [
+            DemoOptions(
+                out=args.out, width=args.width, height=args.height,
+                video=not args.no_video, policy=spec,
+                end_rule="paper" if args.paper_rule and spec == "expert" else "tangent",
+                trust_model=trust,
+            )  # fmt: skip
+            for spec in specs
+        ]
+        for option in options:  # a spec or model that does not fit fails here, on one line
+            check_policy(option)
+        return _fly(args, options, labels)
+    except ValueError as exc:
+        print(f"sgc demo: error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int:
+    import dataclasses
+
     import gymnasium as gym
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-    from rich.table import Table
 
-    import sgc_env  # noqa: F401  (registers the ids)
-    from baselines.cli.demo import ENV_ID, DemoOptions, cpu_seconds, run_demo
+    from baselines.cli.demo import ENV_ID, cpu_seconds, run_demo
+    from baselines.cli.demo_compare import write_side_by_side
+    from baselines.evaluation import write_summary_json
 
     console = Console()
     started = time.perf_counter()
-    # Written next to --out and moved in at the end: an interrupted run leaves the earlier
-    # results whole (no half-written video beside old plates).
+    compare = len(options) > 1
+    results = []
+    # Written next to --out and moved in at the end: an interrupted run (or a model that does
+    # not load) leaves the earlier results whole (no half-written video beside old plates).
     with staged_output(args.out) as stage, Progress(
-        TextColumn("three rods"), BarColumn(), TextColumn("{task.completed}/{task.total} ticks"),
-        TimeRemainingColumn(), console=console,
+        TextColumn("three rods: {task.description}"), BarColumn(),
+        TextColumn("{task.completed}/{task.total} ticks"), TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
-        options = DemoOptions(
-            out=stage, width=args.width, height=args.height, video=not args.no_video,
-            end_rule="paper" if args.paper_rule else "tangent",
-        )  # fmt: skip
-        # the registry's episode length is the demo's tick count, known before the env is built
-        task = bar.add_task("demo", total=gym.spec(ENV_ID).max_episode_steps)
-        result = run_demo(options, lambda done, n: bar.update(task, completed=done, total=n))
-        files = sorted(args.out / path.relative_to(stage) for path in result.files.values())
+        for option, label in zip(options, labels, strict=True):
+            option = dataclasses.replace(option, out=stage / label if compare else stage)
+            # the registry's episode length is the demo's tick count, known before the env is built
+            task = bar.add_task(label, total=gym.spec(ENV_ID).max_episode_steps)
+            results.append(run_demo(option, _ticker(bar, task)))
+        files = [path for result in results for path in result.files.values()]
+        if compare:
+            files.append(write_side_by_side(results[0], results[1], stage))
+            summaries = {r.label: r.summary for r in results}
+            files.append(write_summary_json(summaries, stage / "summary.json"))
+        files = sorted(args.out / path.relative_to(stage) for path in files)
     elapsed = time.perf_counter() - started
 
-    rule = "the paper's k rules" if args.paper_rule else "the tangent rule"
-    table = Table(title=f"three-rod demo: the expert ({rule}), scored by the harness")
+    for option, result in zip(options, results, strict=True):
+        console.print(scorecard_table(option, result))
+        summary = result.summary
+        console.print(f"{result.label}: {summary['goals_met']}/{summary['n_goals']} goals met, "
+                      f"terminated: {bool(summary['terminated'])}; CPU of the run "
+                      f"{result.cpu_s:.1f} s")  # fmt: skip
+    console.print(
+        f"CPU {cpu_seconds():.1f} s since the command started (imports included, ffmpeg's "
+        f"too); {elapsed:.1f} s wall clock"
+    )
+    console.print(f"outputs in {args.out}/:")
+    for path in files:
+        console.print(f"  {path}")
+    missed = any(
+        r.summary["goals_met"] < r.summary["n_goals"] or r.summary["terminated"]
+        for o, r in zip(options, results, strict=True) if o.policy == "expert"
+    )  # fmt: skip
+    return 1 if missed else 0
+
+
+def _ticker(bar: Any, task: Any) -> Any:
+    """``progress(done, total)`` for :func:`run_demo` that moves ``task`` of ``bar``."""
+
+    def tick(done: int, total: int) -> None:
+        bar.update(task, completed=done, total=total)
+
+    return tick
+
+
+def scorecard_table(option: Any, result: Any) -> Any:
+    """The per-rod scorecard of one run, as a rich table."""
+    from rich.table import Table
+
+    if option.policy == "expert":
+        rule = "the paper's k rules" if option.end_rule == "paper" else "the tangent rule"
+        who = f"the expert ({rule})"
+    else:
+        who = f"policy {result.label}"
+    table = Table(title=f"three-rod demo: {who}, scored by the harness")
     table.add_column("rod", no_wrap=True)
     for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
                    "SPARC", "min speed at goals / avg", "kink (m/s²)",
@@ -75,23 +185,12 @@ def run(args: argparse.Namespace) -> int:
     for rod in result.per_rod:
         table.add_row(
             rod["rod"], str(rod["goals"]), str(rod["goals_met"]),
-            f"{rod['position_error_max_m']:.1e}", _fmt(rod["orientation_error_max_rad"]),
+            _fmt(rod["position_error_max_m"]), _fmt(rod["orientation_error_max_rad"]),
             _fmt(rod["closest_approach_offset_max_s"]), _fmt(rod["sparc_track"], ".2f"),
             _fmt(rod["goal_speed_ratio_min"], ".2f"), _fmt(rod["acceleration_kink"], ".1f"),
             _fmt(rod["angular_acceleration_kink"], ".1f"),
         )  # fmt: skip
-    console.print(table)
-    summary = result.summary
-    console.print(
-        f"{summary['goals_met']}/{summary['n_goals']} goals met, terminated: "
-        f"{bool(summary['terminated'])}; CPU {cpu_seconds():.1f} s since the command started "
-        f"(imports included, ffmpeg's too), of which the run {result.cpu_s:.1f} s; "
-        f"{elapsed:.1f} s wall clock"
-    )
-    console.print(f"outputs in {args.out}/:")
-    for path in files:
-        console.print(f"  {path}")
-    return 0 if summary["goals_met"] == summary["n_goals"] and not summary["terminated"] else 1
+    return table
 
 
 def _fmt(value: float | None, spec: str = ".1e") -> str:
