@@ -33,8 +33,8 @@ def test_every_recipe_resolves_on_its_envs() -> None:
             continue
         for env_id in recipe.envs:
             hp = load_hyperparams(recipe.algo, env_id, recipe.hyperparams)
-            if recipe in fast:  # many sub-envs: the point of these recipes
-                assert hp.n_envs >= 64, (recipe.name, env_id)
+            if recipe in fast:  # more sub-envs than ppo-schedule's 8: the point of these
+                assert hp.n_envs >= 16 and hp.n_envs * hp.algo_kwargs["n_steps"] >= 2048
 
 
 def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
