@@ -1,0 +1,59 @@
+"""The shipped recipes file resolves, and scripts/seed_table.py scores finished runs."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("stable_baselines3")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _seed_table():
+    spec = importlib.util.spec_from_file_location("seed_table", ROOT / "scripts" / "seed_table.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_recipe_resolves_on_its_envs() -> None:
+    """A recipe whose folder lacks one of its ids (or has a typo) would fail mid-benchmark."""
+    from baselines.agents.hyperparams import load_hyperparams
+    from baselines.benchmark.grid import load_recipes
+
+    recipes = load_recipes(ROOT / "benchmarks" / "recipes.yml")
+    fast = [r for r in recipes if r.name.startswith("ppo-fast")]
+    assert fast, "no ppo-fast recipe in benchmarks/recipes.yml"
+    for recipe in recipes:
+        if recipe.hyperparams is None:
+            continue
+        for env_id in recipe.envs:
+            hp = load_hyperparams(recipe.algo, env_id, recipe.hyperparams)
+            if recipe in fast:  # more sub-envs than ppo-schedule's 8: the point of these
+                assert hp.n_envs >= 16 and hp.n_envs * hp.algo_kwargs["n_steps"] >= 2048
+
+
+def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
+    from baselines.agents.train import TrainConfig, train
+
+    hp = tmp_path / "hp"
+    hp.mkdir()
+    (hp / "ppo.yml").write_text(
+        "SGCPoint-v0:\n  n_timesteps: 128\n  policy: MlpPolicy\n  n_envs: 2\n  n_steps: 64\n"
+        '  batch_size: 64\n  n_epochs: 1\n  policy_kwargs: "dict(net_arch=[8])"\n'
+    )
+    run = tmp_path / "run"
+    train(TrainConfig("ppo", "SGCPoint-v0", seed=3, timesteps=128, out=run, hyperparams_dir=hp))
+    row = _seed_table().seed_row(run, episodes=1, seed=20_000)
+    assert row["seed"] == 3 and row["steps"] == 128 and row["env_id"] == "SGCPoint-v0"
+    assert row["n_goals"] == 3 and 0 <= row["goals_met"] <= 3
+    assert row["wall_time_s"] > 0 and row["result"]["seed"] == 20_000
+
+
+def test_seed_table_names_a_folder_that_is_not_a_run(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="not a finished run"):
+        _seed_table().seed_row(tmp_path, episodes=1, seed=20_000)
