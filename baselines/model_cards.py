@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.benchmark.manifest import CHECKPOINTS, held_out_result, load_manifest
+from baselines.normalization import statistics_path
 
 __all__ = ["DOCS_IMAGES", "card_markdown", "machine", "recipe", "write_model_card"]
 
@@ -60,6 +61,12 @@ def _result_rows(result: Mapping[str, Any]) -> list[str]:
     ]
 
 
+def _has_json_statistics(model: Path) -> bool:
+    """Whether the model's statistics, found as the loader finds them, are JSON."""
+    found = statistics_path(model)
+    return found is not None and found.suffix == ".json"
+
+
 def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str | None,
                   evaluated_on: str, eval_seconds: float) -> str:  # fmt: skip
     """The card of one manifest ``entry``; ``fresh``: the card step's own evaluation."""
@@ -81,7 +88,7 @@ def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str |
         "trained (the project's shared CPU machine)",
         f"- **File**: `{entry['file']}`"
         + (" with its `VecNormalize` statistics (JSON)"
-           if (CHECKPOINTS / f"{stem}.vecnormalize.json").is_file() else ""),  # fmt: skip
+           if _has_json_statistics(CHECKPOINTS / str(entry["file"])) else ""),  # fmt: skip
         "",
         "## Held-out results",
         "",
