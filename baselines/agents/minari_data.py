@@ -117,9 +117,14 @@ def record_minari(
                 done = terminated or truncated
             buffers.append(
                 EpisodeBuffer(
-                    id=k, seed=seed + k, observations=np.stack(observations),
-                    actions=np.stack(actions), rewards=rewards, terminations=terminations,
-                    truncations=truncations, infos=_stack_infos(infos),
+                    id=k,
+                    seed=seed + k,
+                    observations=np.stack(observations),
+                    actions=np.stack(actions),
+                    rewards=rewards,
+                    terminations=terminations,
+                    truncations=truncations,
+                    infos=_stack_infos(infos),
                 )  # fmt: skip
             )
         return minari.create_dataset_from_buffers(
