@@ -3,9 +3,11 @@
 ``evaluate(policy, env_id, episodes, seed)`` runs episode k with ``reset(seed=seed + k)``,
 keeps the reset info and every step's info, scores each episode with
 :func:`sgc_env.metrics.score_episode` against :func:`goals_from_scenario` of the scenario the
-episode actually ran, and aggregates. It imports neither torch nor SB3 (only a model path
-spec does, through :func:`baselines.policies.make_policy`), so a training callback can call
-it with the model object itself on held-out seeds.
+episode actually ran (:mod:`baselines.episodes`), and aggregates. ``num_envs`` > 1 runs the
+episodes on that many sub-envs of the batched env at once, with the same episodes. It imports
+neither torch nor SB3 (only a model path spec does, through
+:func:`baselines.policies.make_policy`), so a training callback can call it with the model
+object itself on held-out seeds.
 """
 
 from __future__ import annotations
@@ -13,7 +15,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,8 +24,10 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env
+from baselines.episodes import EpisodeRecord, run_episode, run_episodes_batched
 from baselines.policies import Policy, make_policy, policy_label
-from sgc_env.metrics import GoalSpec, Tolerances, goals_from_scenario, score_episode
+from sgc_env.envs.vector_env import make_vec
+from sgc_env.metrics import Tolerances
 
 __all__ = [
     "GOAL_COLUMNS",
@@ -126,23 +129,6 @@ PolicyLike = Policy
 
 
 @dataclass
-class EpisodeRecord:
-    """One scored episode. ``infos`` (and ``initial_info``) are kept only when asked."""
-
-    episode: int
-    seed: int
-    steps: int
-    episode_return: float
-    terminated: bool
-    card: dict[str, Any]
-    goals: list[list[GoalSpec]]
-    dt: float
-    wall_time_s: float
-    infos: list[dict[str, Any]] | None = None
-    initial_info: dict[str, Any] | None = None
-
-
-@dataclass
 class EvaluationResult:
     """All episodes of one policy on one env: per-goal ``rows`` and the ``summary`` card."""
 
@@ -179,65 +165,6 @@ def _first_finite(*values: Any) -> float:
         if v is not None and math.isfinite(v):
             return float(v)
     return math.nan
-
-
-def run_episode(
-    policy: PolicyLike,
-    env: gym.Env,
-    seed: int,
-    *,
-    episode: int = 0,
-    tolerances: Tolerances | None = None,
-    keep_infos: bool = False,
-    max_steps: int = 100_000,
-    frames: list[Any] | None = None,
-    on_step: Callable[[gym.Env, int, Mapping[str, Any]], None] | None = None,
-) -> EpisodeRecord:
-    """Run and score one episode from ``env.reset(seed=seed)`` with a deterministic policy.
-
-    ``frames``: a list to append ``env.render()`` to after the reset and every step (for
-    videos; the env needs ``render_mode="rgb_array"``). ``on_step(env, step, info)`` is called
-    after the reset (step 0) and after every step, for progress bars and custom rendering.
-    """
-    started = time.perf_counter()
-    obs, initial_info = env.reset(seed=seed)
-    if frames is not None:
-        frames.append(env.render())
-    if on_step is not None:
-        on_step(env, 0, initial_info)
-    infos: list[dict[str, Any]] = []
-    state, total, terminated = None, 0.0, False
-    first = True
-    for _ in range(max_steps):
-        action, state = policy.predict(
-            obs, state=state, episode_start=np.array([first]), deterministic=True
-        )
-        first = False
-        obs, reward, terminated, truncated, info = env.step(action)
-        infos.append(info)
-        total += float(reward)
-        if frames is not None:
-            frames.append(env.render())
-        if on_step is not None:
-            on_step(env, len(infos), info)
-        if terminated or truncated:
-            break
-    base: Any = env.unwrapped
-    goals = goals_from_scenario(base.scenario)
-    card = score_episode(infos, goals, base.dt, tolerances, initial_info=initial_info)
-    return EpisodeRecord(
-        episode=episode,
-        seed=seed,
-        steps=len(infos),
-        episode_return=total,
-        terminated=bool(terminated),
-        card=card,
-        goals=goals,
-        dt=float(base.dt),
-        wall_time_s=time.perf_counter() - started,
-        infos=infos if keep_infos else None,
-        initial_info=initial_info if keep_infos else None,
-    )
 
 
 def goal_rows(record: EpisodeRecord, env_id: str, policy: str) -> list[GoalRow]:
@@ -336,8 +263,12 @@ def summarize(
         "angular_velocity_jump_max": _max(c["angular_velocity_jump_max"] for c in cards),
         **{
             f"{key}_max": _max(c[key] for c in cards)
-            for key in ("acceleration_peak", "acceleration_kink", "angular_acceleration_peak",
-                        "angular_acceleration_kink")
+            for key in (
+                "acceleration_peak",
+                "acceleration_kink",
+                "angular_acceleration_peak",
+                "angular_acceleration_kink",
+            )
         },  # fmt: skip
         "speed_minima_mean": _mean(c["speed_minima_total"] for c in cards),
         "goal_speed_ratio_min": _min(b["goal_speed_ratio_min"] for b in bodies),
@@ -376,44 +307,62 @@ def evaluate(
     *,
     label: str | None = None,
     keep_infos: int = 1,
+    num_envs: int = 1,
 ) -> EvaluationResult:
     """Run ``episodes`` seeded episodes (episode k: ``reset(seed=seed + k)``) and score them.
 
     ``policy``: a spec for :func:`make_policy` (``"expert"``, ``"random"``, a model path...),
     an object with an SB3-style ``predict`` (e.g. a model being trained), or a class or
     factory called with the env (for policies that read the env, such as
-    :class:`~baselines.MinimumJerkController`). ``keep_infos``: how many leading episodes
-    keep their infos for plots. The env is created here and closed at the end.
+    :class:`~baselines.MinimumJerkController`; on the batched env it gets the vector env).
+    ``keep_infos``: how many leading episodes keep their infos for plots. ``num_envs``: run
+    on the batched env with ``min(num_envs, episodes)`` sub-envs (1: one single env). The env
+    is created here and closed at the end.
     """
     sgc_env.check_env_id(env_id)
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise ValueError(f"episodes must be an integer >= 1, got {episodes!r}")
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
         raise ValueError(f"seed must be an integer, got {seed!r}")
-    env = gym.make(env_id, **dict(env_kwargs or {}))
+    if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
+        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
+    seed = int(seed)
+    batched = min(num_envs, episodes) > 1
+    env: Any = (
+        make_vec(env_id, min(num_envs, episodes), **dict(env_kwargs or {}))
+        if batched
+        else gym.make(env_id, **dict(env_kwargs or {}))
+    )
     try:
-        if not hasattr(env.unwrapped, "scenario"):
+        probe = env.envs[0] if batched else env.unwrapped
+        if not hasattr(probe, "scenario"):
             raise ValueError(f"env_id: {env_id!r} is not an SGC environment (no scenario)")
-        agent, default_label = _resolve_policy(policy, env, int(seed))
+        agent, default_label = _resolve_policy(policy, env, seed)
         name = label or default_label
-        records = [
-            run_episode(
-                agent,
-                env,
-                int(seed) + k,
-                episode=k,
-                tolerances=tolerances,
-                keep_infos=k < keep_infos,
+        if batched:
+            records = run_episodes_batched(
+                agent, env, [seed + k for k in range(episodes)],
+                tolerances=tolerances, keep_infos=keep_infos,
             )  # fmt: skip
-            for k in range(episodes)
-        ]
+        else:
+            records = [
+                run_episode(
+                    agent,
+                    env,
+                    seed + k,
+                    episode=k,
+                    tolerances=tolerances,
+                    keep_infos=k < keep_infos,
+                )  # fmt: skip
+                for k in range(episodes)
+            ]
     finally:
         env.close()
     rows = [row for r in records for row in goal_rows(r, env_id, name)]
     summary = cast(
-        Scorecard, {"env_id": env_id, "policy": name, "seed": int(seed), **summarize(records, rows)}
+        Scorecard, {"env_id": env_id, "policy": name, "seed": seed, **summarize(records, rows)}
     )
-    return EvaluationResult(env_id, name, int(seed), records, rows, summary)
+    return EvaluationResult(env_id, name, seed, records, rows, summary)
 
 
 def json_ready(value: Any) -> Any:

@@ -13,7 +13,9 @@ mkdir "$work/src"
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$work/src"
 .venv/bin/python -m pip wheel --no-deps --progress-bar off -w "$work/dist" "$work/src" >/dev/null
 wheel="$(ls "$work"/dist/sgc-*.whl)"
-unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint"
+unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint-v0.(zip|md)"
+cards="$(unzip -l "$wheel" | grep -c "baselines/checkpoints/.*\.md$")"
+test "$cards" -eq "$(ls baselines/checkpoints/*.md | wc -l)"  # every shipped model's card
 step "2/4 install $(basename "$wheel")[rl] into a fresh venv"
 python3 -m venv "$work/venv"
 # --no-compile: modules compile on first import instead (saves compiling all of torch)

@@ -8,8 +8,8 @@ cd "$(dirname "$0")/.."
 step() { printf '\n[setup %s] %s\n' "$(date +%H:%M:%S)" "$*"; }
 step "1/3 virtual environment .venv ($(python3 --version))"
 python3 -m venv .venv
-step "2/3 pip itself"
-.venv/bin/python -m pip install --progress-bar on --upgrade pip
+step "2/3 pip itself (the version the set-up was last tested with)"
+.venv/bin/python -m pip install --progress-bar on "pip==26.3"
 step "3/3 the project and its extras rl, ray, dev, minari (pinned by constraints.txt; a few minutes)"
 .venv/bin/python -m pip install --progress-bar on -c constraints.txt \
     "torch==2.13.0" -e ".[rl,ray,dev,minari]"

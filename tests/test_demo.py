@@ -171,6 +171,30 @@ def test_demo_flies_another_policy_with_the_same_outputs(tmp_path, capsys):
     assert f"random: {summary['goals_met']}/58 goals met" in printed
 
 
+@pytest.mark.parametrize(
+    ("argv", "labels"),
+    [
+        (["--compare", "expert,random"], ["expert", "random"]),
+        (["--compare", "expert,random", "--paper-rule"], ["expert-paper", "random"]),
+        (["--paper-rule"], ["expert-paper"]),
+    ],
+)
+def test_demo_labels_say_which_rule_flew_the_expert(argv, labels):
+    import argparse
+
+    from baselines.cli.commands import demo as demo_command
+
+    parser = argparse.ArgumentParser()
+    demo_command.add_arguments(parser)
+    args = parser.parse_args(argv)
+    assert demo_command._labels(args, demo_command._specs(args)) == labels
+
+
+def test_demo_compare_paper_rule_against_expert_paper_is_refused(capsys):
+    assert main(["demo", "--compare", "expert,expert-paper", "--paper-rule"]) == 2
+    assert "more than once" in capsys.readouterr().err
+
+
 def test_demo_compare_writes_both_runs_side_by_side(tmp_path, capsys):
     import imageio.v2 as imageio
 

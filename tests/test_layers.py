@@ -99,6 +99,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.expert",),
     ("baselines.comparison_policies",),
     ("baselines.policies", "baselines"),
+    ("baselines.episodes",),
     ("baselines.evaluation",),
     ("baselines.episode_gif",),
     ("baselines.agents",),

@@ -67,3 +67,25 @@ def test_cli_writes_a_dataset(datasets: Path, capsys: pytest.CaptureFixture[str]
     assert "1 episodes" in capsys.readouterr().out
     assert minari.load_dataset("sgc/intercept/expert-v0").total_episodes == 1
     assert main([*argv[:-2], "--out", "sgc/intercept/pushed-v0", "--push-scale", "0.1"]) == 2
+
+
+@pytest.mark.filterwarnings("ignore:`(author|author_email|code_permalink)` is set to None")
+def test_an_interrupted_write_leaves_no_dataset(
+    datasets: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    real = minari.create_dataset_from_buffers
+
+    def write_then_fail(**kwargs):
+        real(**kwargs)  # the files are written (into the staging folder) ...
+        raise KeyboardInterrupt  # ... and the process is stopped before the rename
+
+    monkeypatch.setattr(minari, "create_dataset_from_buffers", write_then_fail)
+    with pytest.raises(KeyboardInterrupt):
+        record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+    assert not (datasets / "sgc").exists()
+    assert [p.name for p in datasets.iterdir()] == []  # the staging folder went too
+    monkeypatch.setattr(minari, "create_dataset_from_buffers", real)
+    record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+    assert minari.load_dataset("sgc/point/cut-v0").total_episodes == 1
+    with pytest.raises(ValueError, match="already exists"):
+        record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")

@@ -16,19 +16,26 @@ Two choices keep the dataset exact and loadable without changing the env's contr
 
 Episodes are assembled as Minari ``EpisodeBuffer``s and written with
 ``minari.create_dataset_from_buffers`` (HDF5), which needs only ``minari[hdf5]``; Minari's own
-``DataCollector`` would add jax (``minari[create]``) for tree bookkeeping.
+``DataCollector`` would add jax (``minari[create]``) for tree bookkeeping. The dataset is
+written into a hidden staging folder beside Minari's datasets and renamed into place, so an
+interrupted write leaves no half dataset under its id.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Mapping
+import os
+import tempfile
+from collections.abc import Iterator, Mapping
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 import minari
 import numpy as np
 from minari.data_collector import EpisodeBuffer
+from minari.storage.datasets_root_dir import get_dataset_path
 
 __all__ = ["fixed_info", "float64_action_space", "record_minari"]
 
@@ -61,6 +68,34 @@ def fixed_info(info: Mapping[str, Any], n_bodies: int) -> dict[str, Any]:
 
 def _stack_infos(infos: list[dict[str, Any]]) -> dict[str, np.ndarray]:
     return {key: np.stack([np.asarray(i[key]) for i in infos]) for key in infos[0]}
+
+
+@contextlib.contextmanager
+def _datasets_root(path: str) -> Iterator[None]:
+    """Minari reads its datasets folder from ``MINARI_DATASETS_PATH`` at every call."""
+    saved = os.environ.get("MINARI_DATASETS_PATH")
+    os.environ["MINARI_DATASETS_PATH"] = path
+    try:
+        yield
+    finally:
+        if saved is None:
+            del os.environ["MINARI_DATASETS_PATH"]
+        else:
+            os.environ["MINARI_DATASETS_PATH"] = saved
+
+
+def _write_in_place(dataset_id: str, **create: Any) -> minari.MinariDataset:
+    """``minari.create_dataset_from_buffers`` into a staging folder, renamed into place."""
+    target = get_dataset_path(dataset_id)
+    if target.exists():
+        raise ValueError(f"dataset_id: a dataset {dataset_id!r} already exists at {target}")
+    root = get_dataset_path()
+    with tempfile.TemporaryDirectory(dir=root, prefix=".staging-") as staging:
+        with _datasets_root(staging):
+            minari.create_dataset_from_buffers(dataset_id=dataset_id, **create)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        os.rename(Path(staging) / dataset_id, target)
+    return minari.load_dataset(dataset_id)
 
 
 def record_minari(
@@ -117,13 +152,18 @@ def record_minari(
                 done = terminated or truncated
             buffers.append(
                 EpisodeBuffer(
-                    id=k, seed=seed + k, observations=np.stack(observations),
-                    actions=np.stack(actions), rewards=rewards, terminations=terminations,
-                    truncations=truncations, infos=_stack_infos(infos),
+                    id=k,
+                    seed=seed + k,
+                    observations=np.stack(observations),
+                    actions=np.stack(actions),
+                    rewards=rewards,
+                    terminations=terminations,
+                    truncations=truncations,
+                    infos=_stack_infos(infos),
                 )  # fmt: skip
             )
-        return minari.create_dataset_from_buffers(
-            dataset_id=dataset_id,
+        return _write_in_place(
+            dataset_id,
             buffer=buffers,
             env=env,
             eval_env=env.spec,

@@ -78,19 +78,31 @@ def _specs(args: argparse.Namespace) -> list[str]:
     return specs
 
 
+def _labels(args: argparse.Namespace, specs: list[str]) -> list[str]:
+    """Output folder and summary key per policy: the expert flown with ``--paper-rule`` is
+    labelled ``expert-paper`` (the spec that means it), so the outputs say which rule flew."""
+    from baselines.policies import policy_labels
+
+    return policy_labels(
+        ["expert-paper" if args.paper_rule and spec == "expert" else spec for spec in specs]
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     import sgc_env  # noqa: F401  (registers the ids)
     from baselines.cli.demo import DemoOptions, check_policy
-    from baselines.policies import policy_labels
 
     try:
         specs = _specs(args)
-        labels = policy_labels(specs)
+        labels = _labels(args, specs)
         trust = trust_model(args, "demo")
         options = [
             DemoOptions(
-                out=args.out, width=args.width, height=args.height,
-                video=not args.no_video, policy=spec,
+                out=args.out,
+                width=args.width,
+                height=args.height,
+                video=not args.no_video,
+                policy=spec,
                 end_rule="paper" if args.paper_rule and spec == "expert" else "tangent",
                 trust_model=trust,
             )  # fmt: skip

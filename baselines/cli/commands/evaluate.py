@@ -115,12 +115,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
-    parser.add_argument(
-        "--episodes", type=positive_int, default=5, help="episodes per pair"
-    )
+    parser.add_argument("--episodes", type=positive_int, default=5, help="episodes per pair")
     parser.add_argument(
         "--seed", type=nonneg_int, default=EVAL_SEED,
         help="episode k uses seed + k",
+    )  # fmt: skip
+    parser.add_argument(
+        "--num-envs", type=positive_int, default=1, metavar="N",
+        help="run the episodes N at a time on the batched env (one PyBullet world; the same "
+        "episodes as N=1 up to a model's batched float rounding; default 1)",
     )  # fmt: skip
     parser.add_argument("--out", type=out_dir, default=None, help="output folder (see above)")
     parser.add_argument(
@@ -288,7 +291,7 @@ def run(args: argparse.Namespace) -> int:
                 try:
                     result = evaluate(
                         spec, env_id, args.episodes, args.seed, tolerances=tolerances,
-                        label=label,
+                        label=label, num_envs=args.num_envs,
                         env_kwargs=None if args.reward is None else {"reward": args.reward},
                     )  # fmt: skip
                 except ValueError as exc:
