@@ -23,7 +23,7 @@ import yaml
 from sgc_env.paper import quaternion as quat
 from sgc_env.scenario.load import builtin_path
 
-__all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
+__all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "rod_entries", "write_three_rods_yaml"]
 
 ROD_LENGTH = 1.0
 ROD_RADIUS = 0.04
@@ -166,7 +166,7 @@ def _vec(v: np.ndarray) -> list[float]:
     return [round(float(c), 12) for c in v]
 
 
-def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
+def rod_entries(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
     """The rod's body entry (with goals) and its red ball's prop entry."""
     points = np.asarray(spec.waypoints, dtype=float)
     spline, knots = _spline(points)
@@ -184,20 +184,22 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
     goals: list[dict[str, Any]] = []
     previous = start
     pierce = spec.samples_before - 1
-    for j, s in enumerate(params):
-        orientation = _align(previous, tangent(s))
+    # One spline evaluation for every goal (the same floats as one call per goal).
+    nails, tangents = spline(params), tangent(params)
+    for j in range(len(params)):
+        orientation = _align(previous, tangents[j])
         goal: dict[str, Any] = {"point": list(TIP)}
         if j == pierce:
             goal["nail"] = {"prop": f"ball_{spec.name[4:]}"}
             goal["time"] = spec.pierce_time
         else:
-            goal["nail"] = _vec(spline(s))
+            goal["nail"] = _vec(nails[j])
         if j == len(params) - 1:
             goal["time"] = spec.hit_time
         if j == spec.somersault_sample:
             turn = np.asarray(quat.log(quat.mul_conjugate(orientation, previous)))
             angle = float(np.linalg.norm(turn))
-            axis = turn / angle if angle > 1e-9 else np.cross(tangent(s), [0.0, 0.0, 1.0])
+            axis = turn / angle if angle > 1e-9 else np.cross(tangents[j], [0.0, 0.0, 1.0])
             axis = axis / np.linalg.norm(axis)
             goal["relative_rotation"] = _vec(turn + 2.0 * math.pi * axis)
             goal["weight"] = spec.somersault_weight
@@ -252,7 +254,7 @@ def build_three_rods(
     """The three-rod scenario as YAML-ready data (the paper's rods, or drawn ``specs``)."""
     bodies, props = [], []
     for spec in specs:
-        body, ball = _rod(spec)
+        body, ball = rod_entries(spec)
         bodies.append(body)
         props.append(ball)
     props.append(
