@@ -38,7 +38,7 @@ from sgc_env.scenes import intercept, random_scenario, three_rods_random
 TARGET_MS = 10.0
 """Issue 19's bound on a random id's reset (about a tenth of its episode's steps)."""
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
-         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v1", "three_rods"))  # fmt: skip
+         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v2", "three_rods"))  # fmt: skip
 
 
 def _bare_reset_ms(resets: int) -> float:
@@ -105,36 +105,43 @@ def _episode_ms(env_id: str, steps: int) -> float:
 def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     """Checks per kept scene, and the mean ms of one check (0 checks: nan)."""
     calls, seconds = [0], [0.0]
-    check = intercept.demand_bounds
+    checks = ((intercept, "demand_bounds"), (three_rods_random, "course_features"))
+    saved = [getattr(module, name) for module, name in checks]
 
-    def counted(scenario, *args, **kwargs):
-        calls[0] += 1
-        start = time.perf_counter()
-        out = check(scenario, *args, **kwargs)
-        seconds[0] += time.perf_counter() - start
-        return out
+    def counted(check):
+        def timed(*args, **kwargs):
+            calls[0] += 1
+            start = time.perf_counter()
+            out = check(*args, **kwargs)
+            seconds[0] += time.perf_counter() - start
+            return out
 
-    intercept.demand_bounds = three_rods_random.demand_bounds = counted
+        return timed
+
+    for (module, name), check in zip(checks, saved, strict=True):
+        setattr(module, name, counted(check))
     try:
         rng = np.random.default_rng(0)
         for _ in range(scenes):
             random_scenario(rng, family)
     finally:
-        intercept.demand_bounds = three_rods_random.demand_bounds = check
+        for (module, name), check in zip(checks, saved, strict=True):
+            setattr(module, name, check)
     return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
 
 
 PHASES = (
     ("plan", demand, "body_plan"),
     ("bound", intercept, "demand_bounds"),
-    ("bound", three_rods_random, "demand_bounds"),
-    ("build", three_rods_random, "build_three_rods"),
-    ("parse", three_rods_random, "scenario_from_dict"),
+    ("bound", three_rods_random, "course_features"),
+    ("bound", three_rods_random, "demand_bound"),
+    ("build", three_rods_random, "rod_path"),
     ("resolve", intercept, "resolve_scenario"),
-    ("resolve", three_rods_random, "resolve_scenario"),
+    ("resolve", three_rods_random, "_rod_scene"),
 )
-"""Where a draw's CPU time goes: the planner, the bound's sampling of the plan (``bound``
-minus ``plan``), building the rods' YAML-ready data, parsing it, resolving the goal times."""
+"""Where a draw's CPU time goes: the planner, the feasibility bound (the intercept's sampling
+of the plan, ``bound`` minus ``plan``; the rods' planner-free course bound), sampling the
+rods' paths into goals, resolving the goal times into the scene."""
 
 
 @contextmanager
@@ -206,7 +213,7 @@ def main() -> None:
         print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
               f" {episode:11.1f}")  # fmt: skip
     print()
-    keys = ("plan", "bound", "build", "parse", "resolve", "env")
+    keys = ("plan", "bound", "build", "resolve", "env")
     print(f"{'CPU ms per reset':24s}" + "".join(f"{k:>9s}" for k in keys))
     for _, random_id, _ in PAIRS:
         split = _split_ms(random_id, args.resets)

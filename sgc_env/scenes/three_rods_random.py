@@ -8,46 +8,71 @@ drawn too. Rods, balls and the target board keep their geometry, so the observat
 spaces are those of ``SGCThreeRods-v1`` for every draw; the limits are constants of the id
 (twice the paper scene's).
 
-Feasibility: a rod is kept only if bounds of the force and torque along its analytic plan
-(``demand_bounds``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
-Planning the rods costs far more than a reset of a fixed scene (``docs/environments.md`` has
-the figures).
-``tests/test_random_scenes.py`` runs the expert inside PyBullet on the draws.
+Feasibility: a rod is kept only if a planner-free bound of the force and torque its analytic
+plan needs (``sgc_env.scenes.course_bound``, with this family's measured factors
+``BOUND_FACTORS``) stays within ``demand_share`` of the limits; otherwise it is redrawn.
+Planning every draw (v1) made a reset cost ~170 ms; the bound costs a fraction of a
+millisecond, and each rod is built straight into model objects (``_rod_scene``) instead of
+YAML-ready data that is parsed and resolved (``docs/environments.md`` has the figures).
+``tests/test_random_scenes.py`` checks the bound against the planner on fresh draws and runs
+the expert inside PyBullet on the draws.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
-from sgc_env.scenario import Body, Goal, Prop, Scenario, resolve_scenario, scenario_from_dict
-from sgc_env.scenario.demand import demand_bounds
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.routing import resolve_goal_times
+from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
 from sgc_env.scenario.model import grid_time
+from sgc_env.scenes.course_bound import course_features, demand_bound
 from sgc_env.scenes.three_rods import (
+    BALL_COLOR,
+    BALL_RADIUS,
     EMBED_DURATION,
     FORCE_LIMIT,
     MARGIN,
+    ROD_LENGTH,
     ROD_MASS,
+    ROD_RADIUS,
     ROD_SPECS,
     TARGET_CENTER,
     TARGET_FACE_X,
     TARGET_HALF_EXTENTS,
+    TIP,
     TORQUE_LIMIT,
+    RodPath,
     RodSpec,
+    ball_name,
     build_three_rods,
-    rod_entries,
+    rod_path,
 )
 
-__all__ = ["RandomThreeRodsConfig", "random_three_rods"]
+__all__ = [
+    "BOUND_FACTORS", "RandomThreeRodsConfig", "draw_rod", "random_three_rods", "rod_bound",
+]  # fmt: skip
 
 MAX_DRAWS = 1000
 SOMERSAULT_ROD = 1
 """Index in ``ROD_SPECS`` of the rod that turns the somersault (the teal one, as in the paper)."""
+FINE_POINTS = 401
+"""Points per arc-length measurement of a drawn path (the paper's scene uses 2001; the goals
+move by well under a millimetre)."""
+FACTOR_MARGIN = 1.25
+"""On top of the measured factors; ``demand_share`` leaves another 1.25 before the limits."""
+MEASURED_FACTORS = ((1.49, 2.00), (2.57, 4.12), (3.16, 3.12))
+"""Per rod of ``ROD_SPECS``, the largest ``(K_F, K_S)`` of ``sgc_env.scenes.course_bound``
+measured on its draws: ``scripts/fit_course_bound.py --rods 400 --seed 200`` and
+``--rods 200 --seed 100``, and 200 more draws per rod of an exploratory run (the teal rod's
+2.57 and 4.12: one draw; the others stayed below 1.37 and 1.8)."""
+BOUND_FACTORS = tuple((FACTOR_MARGIN * f, FACTOR_MARGIN * s) for f, s in MEASURED_FACTORS)
+"""What the draws use: the measured factors with a margin (``tests/test_random_scenes.py``
+checks the bound against the planner on fresh draws)."""
 
 
 @dataclass(frozen=True)
@@ -176,31 +201,97 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
     """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
-        spec = _rod_spec(rng, ROD_SPECS[k], cfg)
-        if k == SOMERSAULT_ROD:
-            spec = _with_somersault(rng, spec)
-        body, ball = rod_entries(spec)
-        if not _enters_board(body, cfg.min_entry_cosine):
+        scenario = draw_rod(rng, k, cfg)
+        if scenario is None:
             continue
-        # Built straight into model objects and resolved without the field checks: the
-        # entries are valid by construction (tests compare with the YAML route).
-        scenario = resolve_scenario(
-            replace(
-                _template(),
-                bodies=(_body(body, cfg),),
-                props=(_prop(ball), _template().props[-1]),
-                control_frequency=cfg.control_frequency,
-            ),
-            check_plan=False,
-            validate=False,
-        )
-        ((force, torque),) = demand_bounds(scenario)
-        if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
+        bound = rod_bound(scenario, k)
+        if bound is None:
+            continue
+        if bound[0] <= share * cfg.force_limit and bound[1] <= share * cfg.torque_limit:
             return scenario
     raise RuntimeError(
         f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
         "the limits"
     )
+
+
+def rod_bound(scenario: Scenario, k: int) -> tuple[float, float] | None:
+    """The course bound of the force and torque the plan of rod ``k``'s scene needs, or None
+    where its course data admit none (``sgc_env.scenes.course_bound``)."""
+    body = scenario.bodies[0]
+    features = course_features(body, scenario.control_frequency)
+    if features is None:
+        return None
+    return demand_bound(body, features, BOUND_FACTORS[k], float(np.linalg.norm(scenario.gravity)))
+
+
+def draw_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario | None:
+    """One resolved scene of rod ``k`` alone, not yet checked against the limits; None where
+    its tip would not enter the board steeply enough."""
+    spec = _rod_spec(rng, ROD_SPECS[k], cfg)
+    if k == SOMERSAULT_ROD:
+        spec = _with_somersault(rng, spec)
+    path = rod_path(spec, fine=FINE_POINTS)
+    if not _enters_board(path.nails[-2:], cfg.min_entry_cosine):
+        return None
+    return _rod_scene(path, cfg)
+
+
+def _rod_scene(path: RodPath, cfg: RandomThreeRodsConfig) -> Scenario | None:
+    """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
+    and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
+    of their cost (the field checks and dict round trips were half of a draw). None where two
+    routed goal times land on one tick."""
+    spec, f = path.spec, cfg.control_frequency
+    ball = Prop(
+        name=ball_name(spec), shape="sphere", size=(BALL_RADIUS,), color=BALL_COLOR,
+        position=_vec3(path.ball_position), velocity=spec.ball_velocity,
+    )  # fmt: skip
+    n = len(path.orientations)
+    fixed = {
+        path.pierce: spec.pierce_time,
+        n - 2: spec.hit_time,
+        n - 1: spec.hit_time + EMBED_DURATION,
+    }
+    nails = path.nails.copy()
+    nails[path.pierce] = ball.position_at(spec.pierce_time)
+    tip = path.com_start + np.asarray(quat.rotate(path.start, TIP))
+    distances = np.linalg.norm(np.diff(np.vstack((tip, nails)), axis=0), axis=1)
+    somersault = spec.somersault_sample if path.turn is not None else None
+    weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
+    routed = resolve_goal_times(
+        [None if j not in fixed else grid_time(fixed[j], f) for j in range(n)],
+        [j in fixed for j in range(n)], distances.tolist(), weights,
+    )  # fmt: skip
+    times = [grid_time(float(t), f) for t in routed]
+    if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
+        return None
+    rows = nails.tolist()
+    goals = tuple(
+        Goal(
+            nail=tuple(rows[j]),
+            point=TIP,
+            orientation=None if j == somersault else path.orientations[j],
+            relative_rotation=_vec3(path.turn) if j == somersault else None,  # type: ignore[arg-type]
+            time=times[j],
+            critical=j in fixed,
+            weight=weights[j],
+            nail_prop=ball.name if j == path.pierce else None,
+        )
+        for j in range(n)
+    )
+    body = Body(
+        name=spec.name, shape="rod", size=(ROD_LENGTH, ROD_RADIUS), mass=ROD_MASS,
+        position=_vec3(path.com_start), orientation=path.start,
+        linear_velocity=_vec3(path.launch), color=spec.color,
+        force_limit=float(cfg.force_limit), torque_limit=float(cfg.torque_limit), goals=goals,
+        end_velocity=(0.0, 0.0, 0.0), end_angular_velocity=(0.0, 0.0, 0.0), collisions=False,
+    )  # fmt: skip
+    template = _template()
+    return replace(
+        template, bodies=(body,), props=(ball, template.props[-1]), control_frequency=f,
+        resolved=True,
+    )  # fmt: skip
 
 
 @lru_cache(maxsize=1)
@@ -209,65 +300,7 @@ def _template() -> Scenario:
     return scenario_from_dict(build_three_rods(ROD_SPECS[:1], name="three_rods_random"))
 
 
-def _floats(values: Sequence[float]) -> tuple[float, ...]:
-    return tuple(float(x) for x in values)
-
-
-def _unit(q: Sequence[float]) -> tuple[float, ...]:
-    """Normalised as the parser normalises a quaternion (the same floats)."""
-    norm = math.sqrt(sum(x * x for x in q))
-    return tuple(x / norm for x in q)
-
-
-def _goal(g: dict[str, Any]) -> Goal:
-    nail = g["nail"]
-    prop = isinstance(nail, dict)
-    rotation = g.get("relative_rotation")
-    return Goal(
-        nail=None if prop else _floats(nail),  # type: ignore[arg-type]
-        nail_prop=nail["prop"] if prop else None,
-        point=_floats(g["point"]),  # type: ignore[arg-type]
-        orientation=_unit(g["orientation"]) if "orientation" in g else None,  # type: ignore[arg-type]
-        relative_rotation=None if rotation is None else _floats(rotation),  # type: ignore[arg-type]
-        time=float(g["time"]) if "time" in g else None,
-        weight=float(g.get("weight", 1.0)),
-    )
-
-
-def _body(d: dict[str, Any], cfg: RandomThreeRodsConfig) -> Body:
-    """A ``rod_entries`` body as ``scenario_from_dict`` would parse it, with the id's limits."""
-    return Body(
-        name=d["name"],
-        shape=d["shape"],
-        size=_floats(d["size"]),
-        mass=float(d["mass"]),
-        position=_floats(d["position"]),  # type: ignore[arg-type]
-        orientation=_unit(d["orientation"]),  # type: ignore[arg-type]
-        linear_velocity=_floats(d["linear_velocity"]),  # type: ignore[arg-type]
-        color=_floats(d["color"]),  # type: ignore[arg-type]
-        force_limit=float(cfg.force_limit),
-        torque_limit=float(cfg.torque_limit),
-        goals=tuple(_goal(g) for g in d["goals"]),
-        end_velocity=_floats(d["end_velocity"]),  # type: ignore[arg-type]
-        end_angular_velocity=_floats(d["end_angular_velocity"]),  # type: ignore[arg-type]
-        collisions=bool(d["collisions"]),
-    )
-
-
-def _prop(d: dict[str, Any]) -> Prop:
-    return Prop(
-        name=d["name"],
-        shape=d["shape"],
-        size=_floats(d["size"]),
-        color=_floats(d["color"]),  # type: ignore[arg-type]
-        position=_floats(d["position"]),  # type: ignore[arg-type]
-        velocity=_floats(d["velocity"]),  # type: ignore[arg-type]
-        collisions=bool(d["collisions"]),
-    )
-
-
-def _enters_board(body: dict[str, Any], min_cosine: float) -> bool:
+def _enters_board(hit_and_embed: np.ndarray, min_cosine: float) -> bool:
     """The rod's last course (the embed) heads into the board steeply enough."""
-    hit, embed = (np.asarray(gl["nail"], float) for gl in body["goals"][-2:])
-    step = embed - hit
+    step = hit_and_embed[1] - hit_and_embed[0]
     return bool(step[0] / np.linalg.norm(step) >= min_cosine)
