@@ -151,8 +151,8 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
     hit = points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)
     hit[0] = TARGET_FACE_X
-    hit[1] = np.clip(hit[1], TARGET_CENTER[1] - hy, TARGET_CENTER[1] + hy)
-    hit[2] = np.clip(hit[2], TARGET_CENTER[2] - hz, TARGET_CENTER[2] + hz)
+    hit[1] = min(max(hit[1], TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
+    hit[2] = min(max(hit[2], TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
     moved[-1] = hit
     moved[-2][0] = min(moved[-2][0], TARGET_FACE_X - 2.0)
     f = cfg.control_frequency
@@ -162,12 +162,14 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     )
     return replace(
         base,
-        waypoints=tuple(_vec3(p) for p in moved),
+        waypoints=tuple(map(tuple, moved.tolist())),
         samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
         samples_after=after,
         hit_time=grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
         pierce_time=grid_time(rng.uniform(*cfg.pierce_time), f),
-        ball_velocity=_vec3(direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)),
+        ball_velocity=tuple(
+            (direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)).tolist()
+        ),
         somersault_sample=None,
     )
 
