@@ -27,9 +27,9 @@ from __future__ import annotations
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.orientation import neighbour_paces, split_rotation
+from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
 from sgc_env.scenario.demand import inertia_diagonal
-from sgc_env.scenario.model import Body, goal_orientations
+from sgc_env.scenario.model import Body
 
 __all__ = ["PACE_JUMP", "CourseFeatures", "course_features", "demand_bound"]
 
@@ -68,14 +68,8 @@ def _orientation_courses(b: Body, frequency: int) -> tuple[np.ndarray, np.ndarra
     """Rotation vector and duration of every course of the orientation track, split as the
     planner splits it."""
     goals = [g for g in b.goals if g.has_orientation]
-    targets = [q for q in goal_orientations(b) if q is not None]
     times = [float(g.time) for g in goals]  # type: ignore[arg-type]
-    rotations: list[tuple[float, ...]] = []
-    previous = b.orientation
-    for g, q in zip(goals, targets, strict=True):
-        rel = g.relative_rotation
-        rotations.append(rel if rel is not None else quat.log(quat.mul_conjugate(q, previous)))
-        previous = q
+    rotations = goal_rotations(b.orientation, [(g.orientation, g.relative_rotation) for g in goals])
     paces = neighbour_paces(rotations, times, b.angular_velocity, b.end_angular_velocity)
     steps: list[tuple[float, ...]] = []
     ends: list[float] = []
