@@ -18,7 +18,7 @@ from sgc_env.scenario.demand import demand_bounds
 from sgc_env.scenes import RandomInterceptConfig, RandomThreeRodsConfig, random_scenario
 from sgc_env.scenes import intercept as random_intercept
 from sgc_env.scenes import three_rods_random as random_three_rods
-from sgc_env.scenes.three_rods import ROD_SPECS, build_three_rods, rod_path
+from sgc_env.scenes.three_rods import ROD_SPECS, build_three_rods
 
 EXACT = 1e-9
 DEMAND_SHARE = 0.8  # what both families allow the plan's bounds to use of each limit
@@ -172,11 +172,13 @@ def test_a_drawn_rod_is_what_the_yaml_route_makes_of_it(k):
         spec = random_three_rods._rod_spec(rng, ROD_SPECS[k], cfg)
         if k == random_three_rods.SOMERSAULT_ROD:
             spec = random_three_rods._with_somersault(rng, spec)
-        fast = random_three_rods._rod_scene(rod_path(spec), cfg)
+        candidate = random_three_rods._candidate_of(spec, cfg, fine=2001)
+        assert candidate is not None
+        fast = random_three_rods._rod_scene(candidate, cfg)
         data = build_three_rods((spec,), name="three_rods_random")
         data["bodies"][0].update(force_limit=cfg.force_limit, torque_limit=cfg.torque_limit)
         slow = resolve_scenario(scenario_from_dict(data), check_plan=False)
-        assert fast is not None and fast.resolved
+        assert fast.resolved
         _close(fast, slow)
         assert [g.time for g in fast.bodies[0].goals] == [g.time for g in slow.bodies[0].goals]
 
@@ -192,8 +194,13 @@ def test_the_course_bound_stays_above_the_planners_on_fresh_draws():
         for _ in range(40):
             if checked == 18 * (k + 1):
                 break
-            scenario = random_three_rods.draw_rod(rng, k, cfg)
-            bound = None if scenario is None else random_three_rods.rod_bound(scenario, k)
+            candidate = random_three_rods._candidate(rng, k, cfg)
+            if candidate is None:
+                continue
+            scenario = random_three_rods._rod_scene(candidate, cfg)
+            bound = random_three_rods.rod_bound(scenario, k)
+            # what the draw checks, from the rod's arrays before its scene is built
+            assert random_three_rods._candidate_bound(candidate, k) == bound
             if bound is None:
                 continue
             ((force, torque),) = demand_bounds(scenario)

@@ -24,6 +24,8 @@ than ``PACE_JUMP`` times its own pace has no features (``None``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
@@ -31,7 +33,10 @@ from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rot
 from sgc_env.scenario.demand import inertia_diagonal
 from sgc_env.scenario.model import Body
 
-__all__ = ["PACE_JUMP", "CourseFeatures", "course_features", "demand_bound"]
+__all__ = [
+    "PACE_JUMP", "CourseFeatures", "body_bound", "course_features", "demand_bound",
+    "point_feature", "spin_feature",
+]  # fmt: skip
 
 PACE_JUMP = 6.0
 """Largest ``|w_{j-1}| / |w_j|`` with features (on 600 drawn rods the plan stayed bounded up
@@ -53,29 +58,38 @@ def _end(v: tuple[float, float, float] | None) -> np.ndarray:
     return np.zeros(3) if v is None else np.asarray(v, float)
 
 
-def _point(b: Body) -> float:
-    goals = [g for g in b.goals if g.has_position]
-    times = np.array([0.0, *(g.time for g in goals)], float)
-    start = np.asarray(b.position) + np.asarray(quat.rotate(b.orientation, goals[0].point))
-    nails = np.vstack((start, np.array([g.nail for g in goals], float)))
-    durations = np.diff(times)
-    velocities = np.diff(nails, axis=0) / durations[:, None]
-    linear = np.asarray(b.linear_velocity, float)
-    return float(np.max(_changes(velocities, linear, _end(b.end_velocity)) / durations))
+def point_feature(
+    times: Sequence[float],
+    start: np.ndarray,
+    nails: np.ndarray,
+    velocity: np.ndarray,
+    end_velocity: np.ndarray,
+) -> float:
+    """``point`` of a tracked point starting at ``start`` with ``velocity`` and passing
+    ``nails`` (rows) at ``times``."""  # fmt: skip
+    durations = np.diff(np.array([0.0, *times], float))
+    velocities = np.diff(np.vstack((start, nails)), axis=0) / durations[:, None]
+    return float(np.max(_changes(velocities, velocity, end_velocity) / durations))
 
 
-def _orientation_courses(b: Body, frequency: int) -> tuple[np.ndarray, np.ndarray]:
+def _orientation_courses(
+    start: Sequence[float],
+    goals: Sequence[tuple[Sequence[float] | None, Sequence[float] | None]],
+    times: Sequence[float],
+    rates: tuple[np.ndarray, np.ndarray],
+    frequency: int,
+) -> tuple[np.ndarray, np.ndarray]:
     """Rotation vector and duration of every course of the orientation track, split as the
-    planner splits it."""
-    goals = [g for g in b.goals if g.has_orientation]
-    times = [float(g.time) for g in goals]  # type: ignore[arg-type]
-    rotations = goal_rotations(b.orientation, [(g.orientation, g.relative_rotation) for g in goals])
-    paces = neighbour_paces(rotations, times, b.angular_velocity, b.end_angular_velocity)
+    planner splits it (``goals``: ``(orientation, relative_rotation)`` each)."""  # fmt: skip
+    rotations = goal_rotations(start, goals)
+    paces = neighbour_paces(rotations, times, *rates)
     steps: list[tuple[float, ...]] = []
     ends: list[float] = []
     t_prev = 0.0
-    for g, rotation, t, (rate_in, rate_out) in zip(goals, rotations, times, paces, strict=True):
-        if g.relative_rotation is None:
+    for (_, relative), rotation, t, (rate_in, rate_out) in zip(
+        goals, rotations, times, paces, strict=True
+    ):
+        if relative is None:
             steps.append(rotation)
             ends.append(t)
         else:
@@ -88,41 +102,78 @@ def _orientation_courses(b: Body, frequency: int) -> tuple[np.ndarray, np.ndarra
     return np.array(steps, float), np.diff(np.array([0.0, *ends]))
 
 
-def _spin(b: Body, frequency: int) -> float | None:
-    before, after = np.asarray(b.angular_velocity, float), _end(b.end_angular_velocity)
-    if not b.has_orientation_track:
-        return float(np.dot(before, before))
-    steps, durations = _orientation_courses(b, frequency)
+def spin_feature(
+    start: Sequence[float],
+    goals: Sequence[tuple[Sequence[float] | None, Sequence[float] | None]],
+    times: Sequence[float],
+    rates: tuple[np.ndarray, np.ndarray],
+    frequency: int,
+) -> float | None:
+    """``spin`` of an orientation track from ``start`` through ``goals``
+    (``(orientation, relative_rotation)`` each) at ``times``, ``rates`` the initial and end
+    angular velocities; None where a course is entered faster than ``PACE_JUMP`` times its own
+    pace."""  # fmt: skip
+    steps, durations = _orientation_courses(start, goals, times, rates, frequency)
     velocities = steps / durations[:, None]
-    rates = np.linalg.norm(velocities, axis=1)
-    ends = np.array([np.linalg.norm(before), np.linalg.norm(after)])
-    incoming = np.concatenate((ends[:1], rates[:-1]))
-    moving = rates > 1e-9
-    if np.any(incoming[moving] > PACE_JUMP * rates[moving]):
+    speeds = np.linalg.norm(velocities, axis=1)
+    ends = np.array([np.linalg.norm(rates[0]), np.linalg.norm(rates[1])])
+    incoming = np.concatenate((ends[:1], speeds[:-1]))
+    moving = speeds > 1e-9
+    if np.any(incoming[moving] > PACE_JUMP * speeds[moving]):
         return None
-    padded = np.concatenate((ends[:1], rates, ends[1:]))
+    padded = np.concatenate((ends[:1], speeds, ends[1:]))
     fastest = np.maximum(np.maximum(padded[:-2], padded[1:-1]), padded[2:])
-    change = _changes(velocities, before, after) / durations
+    change = _changes(velocities, *rates) / durations
     return float(np.max(change + SPIN_RATE * fastest**2))
 
 
 def course_features(b: Body, frequency: int) -> CourseFeatures | None:
     """``(point, spin)`` of a resolved body at ``frequency`` Hz, or None where an orientation
     course is entered faster than ``PACE_JUMP`` times its own pace."""
-    spin = _spin(b, frequency)
-    if spin is None:
-        return None
-    return (_point(b) if b.has_position_track else 0.0), spin
+    rates = np.asarray(b.angular_velocity, float), _end(b.end_angular_velocity)
+    if b.has_orientation_track:
+        turns = [g for g in b.goals if g.has_orientation]
+        spin = spin_feature(
+            b.orientation, [(g.orientation, g.relative_rotation) for g in turns],
+            [float(g.time) for g in turns], rates, frequency,  # type: ignore[arg-type]
+        )  # fmt: skip
+        if spin is None:
+            return None
+    else:
+        spin = float(np.dot(rates[0], rates[0]))
+    if not b.has_position_track:
+        return 0.0, spin
+    goals = [g for g in b.goals if g.has_position]
+    start = np.asarray(b.position) + np.asarray(quat.rotate(b.orientation, goals[0].point))
+    point = point_feature(
+        [float(g.time) for g in goals], start, np.array([g.nail for g in goals], float),  # type: ignore[arg-type]
+        np.asarray(b.linear_velocity, float), _end(b.end_velocity),
+    )  # fmt: skip
+    return point, spin
 
 
 def demand_bound(
-    b: Body, features: CourseFeatures, factors: tuple[float, float], gravity: float
+    features: CourseFeatures,
+    factors: tuple[float, float],
+    *,
+    mass: float,
+    inertia: float,
+    arm: float,
+    gravity: float,
 ) -> tuple[float, float]:
     """``(force, torque)`` bound of the plan's peaks from ``features`` and a family's measured
-    ``factors`` ``(K_F, K_S)``."""
+    ``factors`` ``(K_F, K_S)``: ``inertia`` the largest principal moment, ``arm`` the tracked
+    point's distance from the centre of mass."""  # fmt: skip
     point, spin = features
     k_force, k_spin = factors
+    return mass * (gravity + k_force * (point + arm * spin)), inertia * k_spin * spin
+
+
+def body_bound(
+    b: Body, features: CourseFeatures, factors: tuple[float, float], gravity: float
+) -> tuple[float, float]:
+    """:func:`demand_bound` with the body's mass, inertia and tracked point."""
     points = {g.point for g in b.goals if g.has_position}
     arm = max((float(np.linalg.norm(p)) for p in points), default=0.0)
     inertia = float(inertia_diagonal(b.shape, b.size, b.mass).max())
-    return b.mass * (gravity + k_force * (point + arm * spin)), inertia * k_spin * spin
+    return demand_bound(features, factors, mass=b.mass, inertia=inertia, arm=arm, gravity=gravity)

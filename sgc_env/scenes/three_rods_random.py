@@ -29,8 +29,15 @@ import numpy as np
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.routing import resolve_goal_times
 from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
-from sgc_env.scenario.model import grid_time
-from sgc_env.scenes.course_bound import course_features, demand_bound
+from sgc_env.scenario.demand import inertia_diagonal
+from sgc_env.scenario.model import Vec3, grid_time
+from sgc_env.scenes.course_bound import (
+    body_bound,
+    course_features,
+    demand_bound,
+    point_feature,
+    spin_feature,
+)
 from sgc_env.scenes.three_rods import (
     BALL_COLOR,
     BALL_RADIUS,
@@ -60,6 +67,7 @@ __all__ = [
 MAX_DRAWS = 1000
 SOMERSAULT_ROD = 1
 """Index in ``ROD_SPECS`` of the rod that turns the somersault (the teal one, as in the paper)."""
+ROD_INERTIA = float(inertia_diagonal("rod", (ROD_LENGTH, ROD_RADIUS), ROD_MASS).max())
 FINE_POINTS = 401
 """Points per arc-length measurement of a drawn path (the paper's scene uses 2001; the goals
 move by well under a millimetre)."""
@@ -200,17 +208,16 @@ def random_three_rods(
 
 
 def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
-    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
+    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits;
+    model objects are built only for the rod kept."""
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
-        scenario = draw_rod(rng, k, cfg)
-        if scenario is None:
-            continue
-        bound = rod_bound(scenario, k)
-        if bound is None:
+        candidate = _candidate(rng, k, cfg)
+        bound = None if candidate is None else _candidate_bound(candidate, k)
+        if bound is None or candidate is None:
             continue
         if bound[0] <= share * cfg.force_limit and bound[1] <= share * cfg.torque_limit:
-            return scenario
+            return _rod_scene(candidate, cfg)
     raise RuntimeError(
         f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
         "the limits"
@@ -219,46 +226,61 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
 
 def rod_bound(scenario: Scenario, k: int) -> tuple[float, float] | None:
     """The course bound of the force and torque the plan of rod ``k``'s scene needs, or None
-    where its course data admit none (``sgc_env.scenes.course_bound``)."""
+    where its course data admit none (``sgc_env.scenes.course_bound``; the draws compute the
+    same floats from the rod's arrays before building its scene, tested)."""
     body = scenario.bodies[0]
     features = course_features(body, scenario.control_frequency)
     if features is None:
         return None
-    return demand_bound(body, features, BOUND_FACTORS[k], float(np.linalg.norm(scenario.gravity)))
+    return body_bound(body, features, BOUND_FACTORS[k], float(np.linalg.norm(scenario.gravity)))
 
 
 def draw_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario | None:
     """One resolved scene of rod ``k`` alone, not yet checked against the limits; None where
-    its tip would not enter the board steeply enough."""
+    its tip would not enter the board steeply enough or two routed goal times share a tick."""
+    candidate = _candidate(rng, k, cfg)
+    return None if candidate is None else _rod_scene(candidate, cfg)
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """A drawn rod's path with its goal times and ball, before any model object exists."""
+
+    path: RodPath
+    ball: Prop
+    nails: np.ndarray
+    times: list[float]
+    fixed: frozenset[int]
+    weights: list[float]
+    somersault: int | None
+    frequency: int
+
+
+def _candidate(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> _Candidate | None:
+    """Draw rod ``k``'s path and route its goal times as ``resolve_scenario`` does."""
     spec = _rod_spec(rng, ROD_SPECS[k], cfg)
     if k == SOMERSAULT_ROD:
         spec = _with_somersault(rng, spec)
-    path = rod_path(spec, fine=FINE_POINTS)
+    return _candidate_of(spec, cfg)
+
+
+def _candidate_of(
+    spec: RodSpec, cfg: RandomThreeRodsConfig, fine: int = FINE_POINTS
+) -> _Candidate | None:
+    path = rod_path(spec, fine=fine)
     if not _enters_board(path.nails[-2:], cfg.min_entry_cosine):
         return None
-    return _rod_scene(path, cfg)
-
-
-def _rod_scene(path: RodPath, cfg: RandomThreeRodsConfig) -> Scenario | None:
-    """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
-    and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
-    of their cost (the field checks and dict round trips were half of a draw). None where two
-    routed goal times land on one tick."""
-    spec, f = path.spec, cfg.control_frequency
+    f = cfg.control_frequency
     ball = Prop(
         name=ball_name(spec), shape="sphere", size=(BALL_RADIUS,), color=BALL_COLOR,
         position=_vec3(path.ball_position), velocity=spec.ball_velocity,
     )  # fmt: skip
     n = len(path.orientations)
-    fixed = {
-        path.pierce: spec.pierce_time,
-        n - 2: spec.hit_time,
-        n - 1: spec.hit_time + EMBED_DURATION,
-    }
+    hit = spec.hit_time
+    fixed = {path.pierce: spec.pierce_time, n - 2: hit, n - 1: hit + EMBED_DURATION}
     nails = path.nails.copy()
     nails[path.pierce] = ball.position_at(spec.pierce_time)
-    tip = path.com_start + np.asarray(quat.rotate(path.start, TIP))
-    distances = np.linalg.norm(np.diff(np.vstack((tip, nails)), axis=0), axis=1)
+    distances = np.linalg.norm(np.diff(np.vstack((_tip(path), nails)), axis=0), axis=1)
     somersault = spec.somersault_sample if path.turn is not None else None
     weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
     routed = resolve_goal_times(
@@ -268,31 +290,65 @@ def _rod_scene(path: RodPath, cfg: RandomThreeRodsConfig) -> Scenario | None:
     times = [grid_time(float(t), f) for t in routed]
     if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
         return None
-    rows = nails.tolist()
+    return _Candidate(path, ball, nails, times, frozenset(fixed), weights, somersault, f)
+
+
+def _tip(path: RodPath) -> np.ndarray:
+    """The tip's start, as ``course_features`` computes it from the built body."""
+    return np.asarray(_vec3(path.com_start)) + np.asarray(quat.rotate(path.start, TIP))
+
+
+def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | None]]:
+    turn = None if c.path.turn is None else _vec3(c.path.turn)
+    return [
+        (None, turn) if j == c.somersault else (q, None) for j, q in enumerate(c.path.orientations)
+    ]
+
+
+def _candidate_bound(c: _Candidate, k: int) -> tuple[float, float] | None:
+    """:func:`rod_bound` of the rod's scene, from its arrays (the same floats)."""
+    rest = np.zeros(3)
+    spin = spin_feature(c.path.start, _orientation_goals(c), c.times, (rest, rest), c.frequency)
+    if spin is None:
+        return None
+    launch = np.asarray(_vec3(c.path.launch))
+    point = point_feature(c.times, _tip(c.path), c.nails, launch, rest)
+    gravity = float(np.linalg.norm(_template().gravity))
+    return demand_bound(
+        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA,
+        arm=float(np.linalg.norm(TIP)), gravity=gravity,
+    )  # fmt: skip
+
+
+def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
+    """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
+    and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
+    of their cost (the field checks and dict round trips were half of a draw)."""
+    spec, rows = c.path.spec, c.nails.tolist()
     goals = tuple(
         Goal(
             nail=tuple(rows[j]),
             point=TIP,
-            orientation=None if j == somersault else path.orientations[j],
-            relative_rotation=_vec3(path.turn) if j == somersault else None,  # type: ignore[arg-type]
-            time=times[j],
-            critical=j in fixed,
-            weight=weights[j],
-            nail_prop=ball.name if j == path.pierce else None,
-        )
-        for j in range(n)
+            orientation=orientation,
+            relative_rotation=relative,
+            time=c.times[j],
+            critical=j in c.fixed,
+            weight=c.weights[j],
+            nail_prop=c.ball.name if j == c.path.pierce else None,
+        )  # fmt: skip
+        for j, (orientation, relative) in enumerate(_orientation_goals(c))
     )
     body = Body(
         name=spec.name, shape="rod", size=(ROD_LENGTH, ROD_RADIUS), mass=ROD_MASS,
-        position=_vec3(path.com_start), orientation=path.start,
-        linear_velocity=_vec3(path.launch), color=spec.color,
+        position=_vec3(c.path.com_start), orientation=c.path.start,
+        linear_velocity=_vec3(c.path.launch), color=spec.color,
         force_limit=float(cfg.force_limit), torque_limit=float(cfg.torque_limit), goals=goals,
         end_velocity=(0.0, 0.0, 0.0), end_angular_velocity=(0.0, 0.0, 0.0), collisions=False,
     )  # fmt: skip
     template = _template()
     return replace(
-        template, bodies=(body,), props=(ball, template.props[-1]), control_frequency=f,
-        resolved=True,
+        template, bodies=(body,), props=(c.ball, template.props[-1]),
+        control_frequency=c.frequency, resolved=True,
     )  # fmt: skip
 
 
