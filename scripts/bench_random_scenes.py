@@ -35,6 +35,7 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
+from sgc_env.envs.vector_env import make_vec
 from sgc_env.scenario import demand
 from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
@@ -148,9 +149,9 @@ rods' paths into goals, routing the goal times and building the scene's objects.
 
 
 def _batched_reset_ms(env_id: str, envs: int, rounds: int) -> float:
-    """CPU ms per sub-env of ``reset(seed=...)`` on the batched env (``vector_entry_point``:
-    every sub-env in one PyBullet client, each reset through ``SubEnvs.reset_one``)."""
-    vec = gym.make_vec(env_id, num_envs=envs, vectorization_mode="vector_entry_point")
+    """CPU ms per sub-env of ``reset(seed=...)`` on the batched env (``make_vec``: every
+    sub-env in one PyBullet client, each reset through ``SubEnvs.reset_one``)."""
+    vec = make_vec(env_id, num_envs=envs)
     vec.reset(seed=0)
     start = time.process_time()
     for r in range(1, rounds + 1):
