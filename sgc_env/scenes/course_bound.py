@@ -29,7 +29,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
 from sgc_env.scenario.demand import inertia_diagonal
 from sgc_env.scenario.model import Body
 
@@ -81,6 +80,10 @@ def _orientation_courses(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Rotation vector and duration of every course of the orientation track, split as the
     planner splits it (``goals``: ``(orientation, relative_rotation)`` each)."""  # fmt: skip
+    # Loaded at the first draw: the orientation module imports scipy, and ``import sgc_env``
+    # (which reads the families for the registry) stays without it.
+    from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
+
     rotations = goal_rotations(start, goals)
     paces = neighbour_paces(rotations, times, *rates)
     steps: list[tuple[float, ...]] = []
