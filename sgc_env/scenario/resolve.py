@@ -132,24 +132,20 @@ def resolve_scenario(
     control_frequency: int | None = None,
     time_grid: str | None = None,
     check_plan: bool = True,
-    validate: bool = True,
 ) -> Scenario:
     """Validate ``scenario`` and fill in every goal time (on the control grid) and prop nail.
 
     ``control_frequency``/``time_grid`` override the scenario's. Idempotent on a resolved
     scenario (non-critical times are re-routed from the critical ones). ``check_plan``: check
     the analytic plan against the limits (see :func:`_check_plan`); callers with a cheaper
-    guarantee of their own (``random_scenarios``) turn it off. ``validate=False`` skips the
-    field checks for builders whose output is valid by construction and tested against this
-    function (``sgc_env.scenes.three_rods_random``: the checks were half of a draw).
+    guarantee of their own (``random_scenarios``) turn it off.
     """
     s = scenario
     if control_frequency is not None:
         s = replace(s, control_frequency=control_frequency)
     if time_grid is not None:
         s = replace(s, time_grid=time_grid)
-    if validate:
-        validate_structure(s)
+    validate_structure(s)
     bodies = []
     for i, b in enumerate(s.bodies):
         p = f"bodies[{i}]"
