@@ -120,7 +120,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=20, help="interleaved rounds; best is kept")
     parser.add_argument(
         "--draws", type=int, default=20,
-        help="random-scene resets timed per id (SGCThreeRodsRandom-v1 draws take ~0.8 s each)",
+        help="random-scene resets timed per id",
     )  # fmt: skip
     args = parser.parse_args()
     width = max(len(env_id) for env_id in sgc_env.ENV_IDS)

@@ -10,12 +10,15 @@ client put back to its start pose and velocity); its share of stepping a full-le
 draw is feasible by construction and never checks); and whether the wall time (``yes``), only
 the CPU time (``cpu``) or neither (``no``) stays within issue 19's 10 ms. Then, as before:
 
-For SGCIntercept(Random)-v0 and SGCThreeRods(Random)-v0: mean ``env.reset(seed=...)`` time on
-the unwrapped env, the ratio random / fixed, how many feasibility checks (``demand_bounds``
-calls: one per drawn interception, one per drawn rod) a kept scene took, and the mean time of
-one check, and for scale the stepping time of a full-length episode of the random id (mean
-step time under seeded random actions times the episode's steps). Last, where the CPU time
-of those random ids' resets goes (``PHASES``; ``env``: everything else, the env's own part).
+For SGCIntercept(Random)-v0 and SGCThreeRods-v1 / SGCThreeRodsRandom-v2: mean
+``env.reset(seed=...)`` time on the unwrapped env, the ratio random / fixed, how many
+feasibility checks (the planner's ``demand_bounds`` per drawn interception, the planner-free
+course bound per drawn rod that enters the board) a kept scene took, and the mean time of one
+check, and for scale the stepping time of a full-length episode of the random id (mean step
+time under seeded random actions times the episode's steps). Then the CPU time per sub-env of
+a reset of the batched env (8 sub-envs, each reset through the same ``SGCEnv.reset``). Last,
+where the CPU time of the two random paper scenes' resets goes (``PHASES``; ``env``:
+everything else: the env's own part, and for the rods drawing the specs).
 
     .venv/bin/python scripts/bench_random_scenes.py [--resets 20] [--rounds 3]
 """
@@ -32,13 +35,14 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
+from sgc_env.envs.vector_env import make_vec
 from sgc_env.scenario import demand
 from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
 TARGET_MS = 10.0
 """Issue 19's bound on a random id's reset (about a tenth of its episode's steps)."""
 PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
-         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v1", "three_rods"))  # fmt: skip
+         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v2", "three_rods"))  # fmt: skip
 
 
 def _bare_reset_ms(resets: int) -> float:
@@ -105,36 +109,56 @@ def _episode_ms(env_id: str, steps: int) -> float:
 def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     """Checks per kept scene, and the mean ms of one check (0 checks: nan)."""
     calls, seconds = [0], [0.0]
-    check = intercept.demand_bounds
+    checks = ((intercept, "demand_bounds"), (three_rods_random, "_candidate_bound"))
+    saved = [getattr(module, name) for module, name in checks]
 
-    def counted(scenario, *args, **kwargs):
-        calls[0] += 1
-        start = time.perf_counter()
-        out = check(scenario, *args, **kwargs)
-        seconds[0] += time.perf_counter() - start
-        return out
+    def counted(check):
+        def timed(*args, **kwargs):
+            calls[0] += 1
+            start = time.perf_counter()
+            out = check(*args, **kwargs)
+            seconds[0] += time.perf_counter() - start
+            return out
 
-    intercept.demand_bounds = three_rods_random.demand_bounds = counted
+        return timed
+
+    for (module, name), check in zip(checks, saved, strict=True):
+        setattr(module, name, counted(check))
     try:
         rng = np.random.default_rng(0)
         for _ in range(scenes):
             random_scenario(rng, family)
     finally:
-        intercept.demand_bounds = three_rods_random.demand_bounds = check
+        for (module, name), check in zip(checks, saved, strict=True):
+            setattr(module, name, check)
     return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
 
 
 PHASES = (
     ("plan", demand, "body_plan"),
     ("bound", intercept, "demand_bounds"),
-    ("bound", three_rods_random, "demand_bounds"),
-    ("build", three_rods_random, "build_three_rods"),
-    ("parse", three_rods_random, "scenario_from_dict"),
+    ("bound", three_rods_random, "_candidate_bound"),
+    ("build", three_rods_random, "rod_path"),
     ("resolve", intercept, "resolve_scenario"),
-    ("resolve", three_rods_random, "resolve_scenario"),
+    ("resolve", three_rods_random, "resolve_goal_times"),
+    ("resolve", three_rods_random, "_rod_scene"),
 )
-"""Where a draw's CPU time goes: the planner, the bound's sampling of the plan (``bound``
-minus ``plan``), building the rods' YAML-ready data, parsing it, resolving the goal times."""
+"""Where a draw's CPU time goes: the planner, the feasibility bound (the intercept's sampling
+of the plan, ``bound`` minus ``plan``; the rods' planner-free course bound), sampling the
+rods' paths into goals, routing the goal times and building the scene's objects."""
+
+
+def _batched_reset_ms(env_id: str, envs: int, rounds: int) -> float:
+    """CPU ms per sub-env of ``reset(seed=...)`` on the batched env (``make_vec``: every
+    sub-env in one PyBullet client, each reset through ``SubEnvs.reset_one``)."""
+    vec = make_vec(env_id, num_envs=envs)
+    vec.reset(seed=0)
+    start = time.process_time()
+    for r in range(1, rounds + 1):
+        vec.reset(seed=1000 * r)
+    elapsed = time.process_time() - start
+    vec.close()
+    return elapsed / (rounds * envs) * 1e3
 
 
 @contextmanager
@@ -206,7 +230,11 @@ def main() -> None:
         print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"
               f" {episode:11.1f}")  # fmt: skip
     print()
-    keys = ("plan", "bound", "build", "parse", "resolve", "env")
+    print(f"{'batched, 8 sub-envs':24s} {'cpu ms per sub-env reset':>25s}")
+    for env_id, _ in _random_ids():
+        print(f"{env_id:24s} {_batched_reset_ms(env_id, 8, args.rounds):25.2f}")
+    print()
+    keys = ("plan", "bound", "build", "resolve", "env")
     print(f"{'CPU ms per reset':24s}" + "".join(f"{k:>9s}" for k in keys))
     for _, random_id, _ in PAIRS:
         split = _split_ms(random_id, args.resets)

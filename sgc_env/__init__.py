@@ -34,7 +34,7 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCThreeRods-v1": (_ENTRY, {"scenario": "three_rods"}),
     "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
     "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
-    "SGCThreeRodsRandom-v1": (_ENTRY, {"random_scenario": "three_rods"}),
+    "SGCThreeRodsRandom-v2": (_ENTRY, {"random_scenario": "three_rods"}),
     "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)

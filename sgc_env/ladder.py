@@ -43,7 +43,7 @@ LADDER: tuple[Rung, ...] = (
         "a somersault; one scene",
     ),
     Rung(
-        "SGCThreeRodsRandom-v1",
+        "SGCThreeRodsRandom-v2",
         "the same, with paths, goal counts, balls and times drawn per reset",
     ),
 )

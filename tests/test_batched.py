@@ -16,7 +16,7 @@ from sgc_env.envs.rewards import REWARD_MODES
 from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
-SIZES = {"SGCThreeRodsRandom-v1": (2, 40), "SGCThreeRods-v1": (2, 45)}
+SIZES = {"SGCThreeRodsRandom-v2": (2, 40), "SGCThreeRods-v1": (2, 45)}
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -1,4 +1,4 @@
-"""The paper's scenes that vary: SGCInterceptRandom-v0 and SGCThreeRodsRandom-v1.
+"""The paper's scenes that vary: SGCInterceptRandom-v0 and SGCThreeRodsRandom-v2.
 
 Every reset draws a new scene from the env's own ``np_random``; the expert meets every goal
 exactly on every draw without needing an action beyond the limits; the spaces never change.
@@ -13,15 +13,17 @@ import pytest
 import sgc_env
 from baselines.expert import SGCExpert
 from sgc_env.envs import SGCEnv
+from sgc_env.scenario import resolve_scenario, scenario_from_dict
 from sgc_env.scenario.demand import demand_bounds
 from sgc_env.scenes import RandomInterceptConfig, RandomThreeRodsConfig, random_scenario
 from sgc_env.scenes import intercept as random_intercept
 from sgc_env.scenes import three_rods_random as random_three_rods
+from sgc_env.scenes.three_rods import ROD_SPECS, build_three_rods
 
 EXACT = 1e-9
 DEMAND_SHARE = 0.8  # what both families allow the plan's bounds to use of each limit
-RANDOM_IDS = ("SGCInterceptRandom-v0", "SGCThreeRodsRandom-v1")
-FIXED_OF = {"SGCInterceptRandom-v0": "SGCIntercept-v0", "SGCThreeRodsRandom-v1": "SGCThreeRods-v1"}
+RANDOM_IDS = ("SGCInterceptRandom-v0", "SGCThreeRodsRandom-v2")
+FIXED_OF = {"SGCInterceptRandom-v0": "SGCIntercept-v0", "SGCThreeRodsRandom-v2": "SGCThreeRods-v1"}
 
 
 def _expert_run(env, expert, seed: int) -> tuple[np.ndarray, list[float], bool]:
@@ -68,7 +70,7 @@ def _check_expert(env_id: str, seeds, *, against_plan: bool = False) -> float:
 
 
 @pytest.mark.parametrize(
-    ("env_id", "seeds"), [("SGCInterceptRandom-v0", range(5)), ("SGCThreeRodsRandom-v1", [0])]
+    ("env_id", "seeds"), [("SGCInterceptRandom-v0", range(5)), ("SGCThreeRodsRandom-v2", [0])]
 )
 def test_expert_is_exact_within_the_limits_on_a_few_draws(env_id, seeds):
     _check_expert(env_id, [2000 + s for s in seeds], against_plan=True)
@@ -139,11 +141,74 @@ def test_draws_keep_the_planned_demand_inside_the_limits():
     for family, count in (("intercept", 20), ("three_rods", 2)):
         for _ in range(count):
             scenario = random_scenario(rng, family)
-            for body, (force, torque) in zip(
-                scenario.bodies, demand_bounds(scenario), strict=True
-            ):
+            for body, (force, torque) in zip(scenario.bodies, demand_bounds(scenario), strict=True):
                 assert force <= DEMAND_SHARE * body.force_limit
                 assert torque <= DEMAND_SHARE * body.torque_limit
+
+
+def _close(a, b, path: str = "") -> None:
+    """Equal structure; floats equal to 1e-9 (the YAML route rounds to 12 digits)."""
+    if isinstance(a, tuple | list):
+        assert isinstance(b, tuple | list) and len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _close(x, y, f"{path}[{i}]")
+    elif hasattr(a, "__dataclass_fields__"):
+        assert type(a) is type(b), path
+        for name in a.__dataclass_fields__:
+            _close(getattr(a, name), getattr(b, name), f"{path}.{name}")
+    elif isinstance(a, float) and not isinstance(a, bool):
+        assert abs(a - b) <= 1e-9, (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+@pytest.mark.parametrize("k", range(len(ROD_SPECS)))
+def test_a_drawn_rod_is_what_the_yaml_route_makes_of_it(k):
+    """The draws build model objects straight from the rod's path, skipping the YAML-ready
+    entries, the parser and resolve_scenario: same scene up to their rounding, times exact."""
+    cfg = RandomThreeRodsConfig()
+    rng = np.random.default_rng(40 + k)
+    for _ in range(3):
+        spec = random_three_rods._rod_spec(rng, ROD_SPECS[k], cfg)
+        if k == random_three_rods.SOMERSAULT_ROD:
+            spec = random_three_rods._with_somersault(rng, spec)
+        candidate = random_three_rods._candidate_of(spec, cfg, fine=2001)
+        assert candidate is not None
+        fast = random_three_rods._rod_scene(candidate, cfg)
+        data = build_three_rods((spec,), name="three_rods_random")
+        data["bodies"][0].update(force_limit=cfg.force_limit, torque_limit=cfg.torque_limit)
+        slow = resolve_scenario(scenario_from_dict(data), check_plan=False)
+        assert fast.resolved
+        _close(fast, slow)
+        assert [g.time for g in fast.bodies[0].goals] == [g.time for g in slow.bodies[0].goals]
+
+
+def test_the_course_bound_stays_above_the_planners_on_fresh_draws():
+    """The planner-free bound the draws check (``course_bound`` with the family's measured
+    factors) against the planner's own bound (``demand_bounds``), on rods drawn before any
+    feasibility check, from seeds the factors were not measured on."""
+    cfg = RandomThreeRodsConfig()
+    rng = np.random.default_rng(9)
+    checked, worst = 0, 0.0
+    for k in range(len(ROD_SPECS)):
+        for _ in range(40):
+            if checked == 18 * (k + 1):
+                break
+            candidate = random_three_rods._candidate(rng, k, cfg)
+            if candidate is None:
+                continue
+            scenario = random_three_rods._rod_scene(candidate, cfg)
+            bound = random_three_rods.rod_bound(scenario, k)
+            # what the draw checks, from the rod's arrays before its scene is built
+            assert random_three_rods._candidate_bound(candidate, k) == bound
+            if bound is None:
+                continue
+            ((force, torque),) = demand_bounds(scenario)
+            assert force <= bound[0] and torque <= bound[1], (k, force, torque, bound)
+            worst = max(worst, force / bound[0], torque / bound[1])
+            checked += 1
+    assert checked == 54
+    print(f"largest planner / course bound over {checked} rods: {worst:.3f}")
 
 
 def test_a_family_follows_the_env_control_frequency():

@@ -123,7 +123,7 @@ def _kink_rows(episodes: int) -> list[dict]:
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     rows = module.compare("SGCThreeRods-v1", 1, 0, "expert")
-    return rows + module.compare("SGCThreeRodsRandom-v1", episodes, 10000, "expert")
+    return rows + module.compare("SGCThreeRodsRandom-v2", episodes, 10000, "expert")
 
 
 @pytest.mark.slow

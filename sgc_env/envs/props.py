@@ -11,6 +11,9 @@ from sgc_env.scenario import Prop
 __all__ = ["PropPaths"]
 
 CHUNK = 1024  # substeps per computed chunk
+FIRST_CHUNK = 16
+"""Substeps of the chunk a reset computes: a reset needs substep 0 only, and a full chunk of
+the three-rod scene's four props cost ~1 ms of its reset (the steps compute the rest)."""
 
 
 class PropPaths:
@@ -28,11 +31,11 @@ class PropPaths:
         """One ``(x, y, z)`` per prop at substep ``min(j, last)``."""
         j = min(j, self.last)
         if not self._start <= j < self._start + len(self._chunk):
-            self._fill(j - j % CHUNK)
+            self._fill(j, FIRST_CHUNK if j == 0 else CHUNK)
         return self._chunk[j - self._start]
 
-    def _fill(self, start: int) -> None:
-        t = np.arange(start, min(start + CHUNK, self.last + 1)) / self._frequency
+    def _fill(self, start: int, size: int) -> None:
+        t = np.arange(start, min(start + size, self.last + 1)) / self._frequency
         table = []
         for p in self._props:
             if p.waypoints:

@@ -86,12 +86,13 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
     prev_q = tuple(body.orientation)
     prev_t = 0.0
     goals = [body.goals[j] for j in ids]
+    rotations = goal_rotations(prev_q, [(g.orientation, g.relative_rotation) for g in goals])
     paces = neighbour_paces(
-        goal_rotations(prev_q, [(g.orientation, g.relative_rotation) for g in goals]),
-        [float(g.time) for g in goals],  # type: ignore[arg-type]
+        rotations, [float(g.time) for g in goals],  # type: ignore[arg-type]
         body.angular_velocity, body.end_angular_velocity,
     )  # fmt: skip
-    for j, (rate_in, rate_out) in zip(ids, paces, strict=True):
+    after_split = False
+    for j, rotation, (rate_in, rate_out) in zip(ids, rotations, paces, strict=True):
         g = body.goals[j]
         t = float(g.time)  # type: ignore[arg-type]
         if g.relative_rotation is not None:
@@ -102,7 +103,11 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
             pieces = [(step, end, k == len(split) - 1) for k, (step, end) in enumerate(split)]
         else:
             q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
-            pieces = [(quat.log(quat.mul_conjugate(q, prev_q)), t, True)]
+            # goal_rotations measured the same step from the same quaternion, unless a split
+            # relative rotation came before (its pieces compose to other floats).
+            step = quat.log(quat.mul_conjugate(q, prev_q)) if after_split else rotation
+            pieces = [(step, t, True)]
+        after_split = g.relative_rotation is not None
         for step, t_piece, last in pieces:
             prev_q = quat.mul(quat.exp_normalized(step), prev_q) if g.relative_rotation else q
             goal_ids.append(j)

@@ -3,7 +3,8 @@
 Every family is a :class:`SceneFamily` (``draw``, ``goal_counts``, ``max_steps``); ``PRESETS``
 names the ones the registered ids use. Modules: ``family`` (the protocol), ``three_rods`` (the
 paper's scene), ``courses`` (one body on a random course), ``intercept`` and
-``three_rods_random`` (random versions of the fixed scenes).
+``three_rods_random`` (random versions of the fixed scenes), ``course_bound`` (the planner-free
+demand bound the three-rod draws check).
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ from it (a test checks that the shipped file is what this module builds).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,13 +24,17 @@ import yaml
 from sgc_env.paper import quaternion as quat
 from sgc_env.scenario.load import builtin_path
 
-__all__ = ["ROD_SPECS", "RodSpec", "build_three_rods", "write_three_rods_yaml"]
+__all__ = [
+    "ROD_SPECS", "RodPath", "RodSpec", "ball_name", "build_three_rods", "rod_entries", "rod_path",
+    "write_three_rods_yaml",
+]  # fmt: skip
 
 ROD_LENGTH = 1.0
 ROD_RADIUS = 0.04
 ROD_MASS = 1.0
 TIP = (0.0, 0.0, ROD_LENGTH / 2)
 BALL_RADIUS = 0.22
+BALL_COLOR = (0.85, 0.08, 0.08, 1.0)
 PIERCE_TIME = 1.2
 EMBED_DEPTH = 0.2
 EMBED_DURATION = 0.15
@@ -127,24 +132,30 @@ def _spline(points: np.ndarray):
     return make_interp_spline(knots, points, k=3), knots
 
 
-def _arc_length_samples(spline, s0: float, s1: float, count: int) -> np.ndarray:
-    """Parameters of ``count`` points equally spaced in arc length on (s0, s1], s1 included."""
-    fine = np.linspace(s0, s1, 2001)
-    pts = spline(fine)
-    arc = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
-    wanted = arc[-1] * np.arange(1, count + 1) / count
-    params = np.interp(wanted, arc, fine)
-    params[-1] = s1
-    return params
+def _arc_length_samples(
+    spline, bounds: tuple[float, ...], counts: tuple[int, ...], fine: int
+) -> np.ndarray:
+    """Parameters of ``counts[i]`` points equally spaced in arc length on each
+    ``(bounds[i], bounds[i + 1]]``, its end included, the arc length measured on ``fine``
+    points per stretch (one spline evaluation for all stretches)."""
+    grids = [np.linspace(s0, s1, fine) for s0, s1 in zip(bounds[:-1], bounds[1:], strict=True)]
+    points = spline(np.concatenate(grids)).reshape(len(grids), fine, -1)
+    out = []
+    for grid, pts, count in zip(grids, points, counts, strict=True):
+        arc = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))))
+        params = np.interp(arc[-1] * np.arange(1, count + 1) / count, arc, grid)
+        params[-1] = grid[-1]
+        out.append(params)
+    return np.concatenate(out)
 
 
-def _align(previous: quat.Quat, tangent: np.ndarray) -> quat.Quat:
+def _align(previous: quat.Quat, tangent: Sequence[float] | np.ndarray) -> quat.Quat:
     """``previous`` turned by the smallest rotation that points its z axis along ``tangent``.
 
     Plain-float quaternions (``sgc_env.paper.quaternion``): a random three-rod draw aligns
     ~20 goals per rod, and scipy's ``Rotation`` cost ~30 ms of it."""
     ax, ay, az = quat.rotate(previous, (0.0, 0.0, 1.0))
-    tx, ty, tz = (float(c) for c in tangent)
+    tx, ty, tz = map(float, tangent)
     n = math.sqrt(tx * tx + ty * ty + tz * tz)
     tx, ty, tz = tx / n, ty / n, tz / n
     cx, cy, cz = ay * tz - az * ty, az * tx - ax * tz, ax * ty - ay * tx
@@ -166,53 +177,99 @@ def _vec(v: np.ndarray) -> list[float]:
     return [round(float(c), 12) for c in v]
 
 
-def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The rod's body entry (with goals) and its red ball's prop entry."""
+@dataclass(frozen=True)
+class RodPath:
+    """One rod's start state, goals and ball, unrounded: what :func:`rod_entries` writes as
+    YAML-ready data and the random family turns into model objects directly.
+
+    ``nails[j]`` and ``orientations[j]`` per goal (the embed last); the pierce goal's nail is
+    the ball (``nails`` holds the path's point there); the somersault goal asks for
+    ``turn`` (a relative rotation) instead of its orientation."""
+
+    spec: RodSpec
+    start: quat.Quat
+    com_start: np.ndarray
+    launch: np.ndarray
+    nails: np.ndarray
+    orientations: list[quat.Quat]
+    turn: np.ndarray | None
+    ball_position: np.ndarray
+
+    @property
+    def pierce(self) -> int:
+        return self.spec.samples_before - 1
+
+
+def rod_path(spec: RodSpec, fine: int = 2001) -> RodPath:
+    """The rod's path sampled into goals (``fine``: points per arc-length measurement)."""
     points = np.asarray(spec.waypoints, dtype=float)
     spline, knots = _spline(points)
-    tangent = spline.derivative()
-    params = np.concatenate(
-        (
-            _arc_length_samples(spline, knots[0], knots[spec.ball_index], spec.samples_before),
-            _arc_length_samples(spline, knots[spec.ball_index], knots[-1], spec.samples_after),
-        )
+
+    def tangent(s: np.ndarray) -> np.ndarray:
+        return spline(s, nu=1)  # no derivative spline built: a tenth of the rod's build
+
+    ball = spec.ball_index
+    params = _arc_length_samples(
+        spline, (knots[0], knots[ball], knots[-1]), (spec.samples_before, spec.samples_after), fine
     )
-    start = _align(_align((0.0, 0.0, 0.0, 1.0), np.array([1.0, 0.0, 0.0])), tangent(knots[0]))
-    tip_start = points[0]
-    com_start = tip_start - np.asarray(quat.rotate(start, TIP))
-    launch = tangent(knots[0]) / np.linalg.norm(tangent(knots[0])) * LAUNCH_SPEED
-    goals: list[dict[str, Any]] = []
+    first = tangent(knots[0])
+    start = _align(_align((0.0, 0.0, 0.0, 1.0), np.array([1.0, 0.0, 0.0])), first)
+    com_start = points[0] - np.asarray(quat.rotate(start, TIP))
+    launch = first / np.linalg.norm(first) * LAUNCH_SPEED
+    # One spline evaluation for every goal (the same floats as one call per goal); the last
+    # parameter is the path's end, where the tip hits the board.
+    nails, tangent_rows = spline(params), tangent(params)
+    tangents = tangent_rows.tolist()
+    orientations, turn = [], None
     previous = start
-    pierce = spec.samples_before - 1
-    for j, s in enumerate(params):
-        orientation = _align(previous, tangent(s))
+    for j, direction in enumerate(tangents):
+        orientation = _align(previous, direction)
+        if j == spec.somersault_sample:
+            step = np.asarray(quat.log(quat.mul_conjugate(orientation, previous)))
+            angle = float(np.linalg.norm(step))
+            axis = step / angle if angle > 1e-9 else np.cross(direction, [0.0, 0.0, 1.0])
+            turn = step + 2.0 * math.pi * axis / np.linalg.norm(axis)
+        orientations.append(orientation)
+        previous = orientation
+    end = tangent_rows[-1] / np.linalg.norm(tangent_rows[-1])
+    embed = nails[-1] + end * (EMBED_DEPTH / end[0])
+    orientations.append(previous)
+    ball_position = points[ball] - np.asarray(spec.ball_velocity) * spec.pierce_time
+    return RodPath(
+        spec, start, com_start, launch, np.vstack((nails, embed)), orientations, turn,
+        ball_position,
+    )  # fmt: skip
+
+
+def ball_name(spec: RodSpec) -> str:
+    return f"ball_{spec.name[4:]}"
+
+
+def rod_entries(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The rod's body entry (with goals) and its red ball's prop entry."""
+    path = rod_path(spec)
+    goals: list[dict[str, Any]] = []
+    last = len(path.orientations) - 2  # the hit (the embed follows)
+    for j, orientation in enumerate(path.orientations[:-1]):
         goal: dict[str, Any] = {"point": list(TIP)}
-        if j == pierce:
-            goal["nail"] = {"prop": f"ball_{spec.name[4:]}"}
+        if j == path.pierce:
+            goal["nail"] = {"prop": ball_name(spec)}
             goal["time"] = spec.pierce_time
         else:
-            goal["nail"] = _vec(spline(s))
-        if j == len(params) - 1:
+            goal["nail"] = _vec(path.nails[j])
+        if j == last:
             goal["time"] = spec.hit_time
-        if j == spec.somersault_sample:
-            turn = np.asarray(quat.log(quat.mul_conjugate(orientation, previous)))
-            angle = float(np.linalg.norm(turn))
-            axis = turn / angle if angle > 1e-9 else np.cross(tangent(s), [0.0, 0.0, 1.0])
-            axis = axis / np.linalg.norm(axis)
-            goal["relative_rotation"] = _vec(turn + 2.0 * math.pi * axis)
+        if j == spec.somersault_sample and path.turn is not None:
+            goal["relative_rotation"] = _vec(path.turn)
             goal["weight"] = spec.somersault_weight
         else:
             goal["orientation"] = _quat(orientation)
         goals.append(goal)
-        previous = orientation
-    hit = spline(knots[-1])
-    direction = tangent(knots[-1]) / np.linalg.norm(tangent(knots[-1]))
-    embed = hit + direction * (EMBED_DEPTH / direction[0])
     goals.append(
         {
             "point": list(TIP),
-            "nail": _vec(embed),
-            "orientation": _quat(previous),
+            "nail": _vec(path.nails[-1]),
+            "orientation": _quat(path.orientations[-1]),
             "time": round(spec.hit_time + EMBED_DURATION, 12),
         }
     )
@@ -222,9 +279,9 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
         "size": [ROD_LENGTH, ROD_RADIUS],
         "mass": ROD_MASS,
         "color": list(spec.color),
-        "position": _vec(com_start),
-        "orientation": _quat(start),
-        "linear_velocity": _vec(launch),
+        "position": _vec(path.com_start),
+        "orientation": _quat(path.start),
+        "linear_velocity": _vec(path.launch),
         "force_limit": FORCE_LIMIT,
         "torque_limit": TORQUE_LIMIT,
         "end_velocity": [0.0, 0.0, 0.0],
@@ -232,15 +289,13 @@ def _rod(spec: RodSpec) -> tuple[dict[str, Any], dict[str, Any]]:
         "collisions": False,
         "goals": goals,
     }
-    ball_at_pierce = points[spec.ball_index]
-    velocity = np.asarray(spec.ball_velocity)
     ball = {
-        "name": f"ball_{spec.name[4:]}",
+        "name": ball_name(spec),
         "shape": "sphere",
         "size": [BALL_RADIUS],
-        "color": [0.85, 0.08, 0.08, 1.0],
-        "position": _vec(ball_at_pierce - velocity * spec.pierce_time),
-        "velocity": _vec(velocity),
+        "color": list(BALL_COLOR),
+        "position": _vec(path.ball_position),
+        "velocity": _vec(np.asarray(spec.ball_velocity)),
         "collisions": False,
     }
     return body, ball
@@ -252,7 +307,7 @@ def build_three_rods(
     """The three-rod scenario as YAML-ready data (the paper's rods, or drawn ``specs``)."""
     bodies, props = [], []
     for spec in specs:
-        body, ball = _rod(spec)
+        body, ball = rod_entries(spec)
         bodies.append(body)
         props.append(ball)
     props.append(

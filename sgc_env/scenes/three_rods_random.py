@@ -8,42 +8,81 @@ drawn too. Rods, balls and the target board keep their geometry, so the observat
 spaces are those of ``SGCThreeRods-v1`` for every draw; the limits are constants of the id
 (twice the paper scene's).
 
-Feasibility: a rod is kept only if bounds of the force and torque along its analytic plan
-(``demand_bounds``) stay within ``demand_share`` of the limits; otherwise it is redrawn.
-Planning the rods costs far more than a reset of a fixed scene (``docs/environments.md`` has
-the figures).
-``tests/test_random_scenes.py`` runs the expert inside PyBullet on the draws.
+Feasibility: a rod is kept only if a planner-free bound of the force and torque its analytic
+plan needs (``sgc_env.scenes.course_bound``, with this family's measured factors
+``BOUND_FACTORS``) stays within ``demand_share`` of the limits; otherwise it is redrawn.
+Planning every draw (v1) made a reset cost ~170 ms; the bound costs a fraction of a
+millisecond, and each rod is built straight into model objects (``_rod_scene``) instead of
+YAML-ready data that is parsed and resolved (``docs/environments.md`` has the figures).
+``tests/test_random_scenes.py`` checks the bound against the planner on fresh draws and runs
+the expert inside PyBullet on the draws.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
-from sgc_env.scenario import Scenario, resolve_scenario, scenario_from_dict
-from sgc_env.scenario.demand import demand_bounds
-from sgc_env.scenario.model import grid_time
+from sgc_env.paper import quaternion as quat
+from sgc_env.paper.routing import resolve_goal_times
+from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
+from sgc_env.scenario.demand import inertia_diagonal
+from sgc_env.scenario.model import Vec3, grid_time
+from sgc_env.scenes.course_bound import (
+    body_bound,
+    course_features,
+    demand_bound,
+    point_feature,
+    spin_feature,
+)
 from sgc_env.scenes.three_rods import (
+    BALL_COLOR,
+    BALL_RADIUS,
     EMBED_DURATION,
     FORCE_LIMIT,
     MARGIN,
+    ROD_LENGTH,
     ROD_MASS,
+    ROD_RADIUS,
     ROD_SPECS,
     TARGET_CENTER,
     TARGET_FACE_X,
     TARGET_HALF_EXTENTS,
+    TIP,
     TORQUE_LIMIT,
+    RodPath,
     RodSpec,
+    ball_name,
     build_three_rods,
+    rod_path,
 )
 
-__all__ = ["RandomThreeRodsConfig", "random_three_rods"]
+__all__ = [
+    "BOUND_FACTORS", "RandomThreeRodsConfig", "draw_rod", "random_three_rods", "rod_bound",
+]  # fmt: skip
 
 MAX_DRAWS = 1000
 SOMERSAULT_ROD = 1
 """Index in ``ROD_SPECS`` of the rod that turns the somersault (the teal one, as in the paper)."""
+ROD_INERTIA = float(inertia_diagonal("rod", (ROD_LENGTH, ROD_RADIUS), ROD_MASS).max())
+FINE_POINTS = 401
+"""Points per arc-length measurement of a drawn path (the paper's scene uses 2001; the goals
+move by well under a millimetre)."""
+FACTOR_MARGIN = 1.25
+"""On top of the measured factors; ``demand_share`` leaves another 1.25 before the limits."""
+MEASURED_FACTORS = ((1.49, 2.00), (2.57, 4.12), (3.16, 3.12))
+"""Per rod of ``ROD_SPECS``, the largest ``(K_F, K_S)`` of ``sgc_env.scenes.course_bound``
+measured on its draws: ``scripts/fit_course_bound.py --rods 400 --seed 200``, ``--rods 200
+--seed 100`` and ``--rods 150 --seed 300`` (the violet rod's 3.12), and 200 more draws per rod
+of an exploratory run (the teal rod's 2.57 and 4.12: one draw; its others stayed below 1.37
+and 1.8). The largest values grew with the number of draws (violet's K_S: 2.44, 2.70, 3.12),
+hence the margin."""
+BOUND_FACTORS = tuple((FACTOR_MARGIN * f, FACTOR_MARGIN * s) for f, s in MEASURED_FACTORS)
+"""What the draws use: the measured factors with a margin (``tests/test_random_scenes.py``
+checks the bound against the planner on fresh draws)."""
 
 
 @dataclass(frozen=True)
@@ -122,8 +161,8 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
     hit = points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)
     hit[0] = TARGET_FACE_X
-    hit[1] = np.clip(hit[1], TARGET_CENTER[1] - hy, TARGET_CENTER[1] + hy)
-    hit[2] = np.clip(hit[2], TARGET_CENTER[2] - hz, TARGET_CENTER[2] + hz)
+    hit[1] = min(max(hit[1], TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
+    hit[2] = min(max(hit[2], TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
     moved[-1] = hit
     moved[-2][0] = min(moved[-2][0], TARGET_FACE_X - 2.0)
     f = cfg.control_frequency
@@ -133,12 +172,14 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
     )
     return replace(
         base,
-        waypoints=tuple(_vec3(p) for p in moved),
+        waypoints=tuple(map(tuple, moved.tolist())),
         samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
         samples_after=after,
         hit_time=grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
         pierce_time=grid_time(rng.uniform(*cfg.pierce_time), f),
-        ball_velocity=_vec3(direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)),
+        ball_velocity=tuple(
+            (direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)).tolist()
+        ),
         somersault_sample=None,
     )
 
@@ -169,32 +210,157 @@ def random_three_rods(
 
 
 def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
-    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits."""
+    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits;
+    model objects are built only for the rod kept."""
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
-        spec = _rod_spec(rng, ROD_SPECS[k], cfg)
-        if k == SOMERSAULT_ROD:
-            spec = _with_somersault(rng, spec)
-        data = build_three_rods((spec,), name="three_rods_random")
-        data["control_frequency"] = cfg.control_frequency
-        (body,) = data["bodies"]
-        if not _enters_board(body, cfg.min_entry_cosine):
+        candidate = _candidate(rng, k, cfg)
+        bound = None if candidate is None else _candidate_bound(candidate, k)
+        if bound is None or candidate is None:
             continue
-        body["force_limit"], body["torque_limit"] = cfg.force_limit, cfg.torque_limit
-        # The demand share below is the feasibility check (stricter than resolve_scenario's
-        # plan check, which would run the planner twice and raise instead of redraw).
-        scenario = resolve_scenario(scenario_from_dict(data), check_plan=False)
-        ((force, torque),) = demand_bounds(scenario)
-        if force <= share * cfg.force_limit and torque <= share * cfg.torque_limit:
-            return scenario
+        if bound[0] <= share * cfg.force_limit and bound[1] <= share * cfg.torque_limit:
+            return _rod_scene(candidate, cfg)
     raise RuntimeError(
         f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
         "the limits"
     )
 
 
-def _enters_board(body: dict, min_cosine: float) -> bool:
+def rod_bound(scenario: Scenario, k: int) -> tuple[float, float] | None:
+    """The course bound of the force and torque the plan of rod ``k``'s scene needs, or None
+    where its course data admit none (``sgc_env.scenes.course_bound``; the draws compute the
+    same floats from the rod's arrays before building its scene, tested)."""
+    body = scenario.bodies[0]
+    features = course_features(body, scenario.control_frequency)
+    if features is None:
+        return None
+    return body_bound(body, features, BOUND_FACTORS[k], float(np.linalg.norm(scenario.gravity)))
+
+
+def draw_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario | None:
+    """One resolved scene of rod ``k`` alone, not yet checked against the limits; None where
+    its tip would not enter the board steeply enough or two routed goal times share a tick."""
+    candidate = _candidate(rng, k, cfg)
+    return None if candidate is None else _rod_scene(candidate, cfg)
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """A drawn rod's path with its goal times and ball, before any model object exists."""
+
+    path: RodPath
+    ball: Prop
+    nails: np.ndarray
+    times: list[float]
+    fixed: frozenset[int]
+    weights: list[float]
+    somersault: int | None
+    frequency: int
+
+
+def _candidate(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> _Candidate | None:
+    """Draw rod ``k``'s path and route its goal times as ``resolve_scenario`` does."""
+    spec = _rod_spec(rng, ROD_SPECS[k], cfg)
+    if k == SOMERSAULT_ROD:
+        spec = _with_somersault(rng, spec)
+    return _candidate_of(spec, cfg)
+
+
+def _candidate_of(
+    spec: RodSpec, cfg: RandomThreeRodsConfig, fine: int = FINE_POINTS
+) -> _Candidate | None:
+    path = rod_path(spec, fine=fine)
+    if not _enters_board(path.nails[-2:], cfg.min_entry_cosine):
+        return None
+    f = cfg.control_frequency
+    ball = Prop(
+        name=ball_name(spec), shape="sphere", size=(BALL_RADIUS,), color=BALL_COLOR,
+        position=_vec3(path.ball_position), velocity=spec.ball_velocity,
+    )  # fmt: skip
+    n = len(path.orientations)
+    hit = spec.hit_time
+    fixed = {path.pierce: spec.pierce_time, n - 2: hit, n - 1: hit + EMBED_DURATION}
+    nails = path.nails.copy()
+    nails[path.pierce] = ball.position_at(spec.pierce_time)
+    distances = np.linalg.norm(np.diff(np.vstack((_tip(path), nails)), axis=0), axis=1)
+    somersault = spec.somersault_sample if path.turn is not None else None
+    weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
+    routed = resolve_goal_times(
+        [None if j not in fixed else grid_time(fixed[j], f) for j in range(n)],
+        [j in fixed for j in range(n)], distances.tolist(), weights,
+    )  # fmt: skip
+    times = [grid_time(float(t), f) for t in routed]
+    if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
+        return None
+    return _Candidate(path, ball, nails, times, frozenset(fixed), weights, somersault, f)
+
+
+def _tip(path: RodPath) -> np.ndarray:
+    """The tip's start, as ``course_features`` computes it from the built body."""
+    return np.asarray(_vec3(path.com_start)) + np.asarray(quat.rotate(path.start, TIP))
+
+
+def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | None]]:
+    turn = None if c.path.turn is None else _vec3(c.path.turn)
+    return [
+        (None, turn) if j == c.somersault else (q, None) for j, q in enumerate(c.path.orientations)
+    ]
+
+
+def _candidate_bound(c: _Candidate, k: int) -> tuple[float, float] | None:
+    """:func:`rod_bound` of the rod's scene, from its arrays (the same floats)."""
+    rest = np.zeros(3)
+    spin = spin_feature(c.path.start, _orientation_goals(c), c.times, (rest, rest), c.frequency)
+    if spin is None:
+        return None
+    launch = np.asarray(_vec3(c.path.launch))
+    point = point_feature(c.times, _tip(c.path), c.nails, launch, rest)
+    gravity = float(np.linalg.norm(_template().gravity))
+    return demand_bound(
+        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA,
+        arm=float(np.linalg.norm(TIP)), gravity=gravity,
+    )  # fmt: skip
+
+
+def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
+    """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
+    and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
+    of their cost (the field checks and dict round trips were half of a draw)."""
+    spec, rows = c.path.spec, c.nails.tolist()
+    goals = tuple(
+        Goal(
+            nail=tuple(rows[j]),
+            point=TIP,
+            orientation=orientation,
+            relative_rotation=relative,
+            time=c.times[j],
+            critical=j in c.fixed,
+            weight=c.weights[j],
+            nail_prop=c.ball.name if j == c.path.pierce else None,
+        )  # fmt: skip
+        for j, (orientation, relative) in enumerate(_orientation_goals(c))
+    )
+    body = Body(
+        name=spec.name, shape="rod", size=(ROD_LENGTH, ROD_RADIUS), mass=ROD_MASS,
+        position=_vec3(c.path.com_start), orientation=c.path.start,
+        linear_velocity=_vec3(c.path.launch), color=spec.color,
+        force_limit=float(cfg.force_limit), torque_limit=float(cfg.torque_limit), goals=goals,
+        end_velocity=(0.0, 0.0, 0.0), end_angular_velocity=(0.0, 0.0, 0.0), collisions=False,
+    )  # fmt: skip
+    template = _template()
+    return replace(
+        template, bodies=(body,), props=(c.ball, template.props[-1]),
+        control_frequency=c.frequency, resolved=True,
+    )  # fmt: skip
+
+
+@lru_cache(maxsize=1)
+def _template() -> Scenario:
+    """The paper's gold rod alone, parsed once: the draws reuse its scene fields and target."""
+    return scenario_from_dict(build_three_rods(ROD_SPECS[:1], name="three_rods_random"))
+
+
+def _enters_board(hit_and_embed: np.ndarray, min_cosine: float) -> bool:
     """The rod's last course (the embed) heads into the board steeply enough."""
-    hit, embed = (np.asarray(gl["nail"], float) for gl in body["goals"][-2:])
-    step = embed - hit
+    step = hit_and_embed[1] - hit_and_embed[0]
     return bool(step[0] / np.linalg.norm(step) >= min_cosine)
