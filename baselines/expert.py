@@ -213,10 +213,10 @@ class SGCExpert:
         lookup = course_key(key)
         if self._table is None or (lookup not in self._table and self._env is not None):
             scenario = self._scenario if self._env is None else base_env(self._env).scenario
-            if self._table is None or scenario is not self._scenario:
+            if scenario is not None and (self._table is None or scenario is not self._scenario):
                 self._scenario = scenario
                 self._table = matched_table(scenario)
-        return self._table.get(lookup)
+        return None if self._table is None else self._table.get(lookup)
 
 
 def substep_lag(period: float, substeps: int) -> float:

@@ -30,9 +30,9 @@ from baselines.comparison_policies import (
     DynamicConstraintsController,
     MinimumJerkController,
     episode_model,
-    scenario_of,
     observation_tick,
     predict_per_env,
+    scenario_of,
 )
 from baselines.expert import SGCExpert
 from baselines.model_files import algorithm_from_data, load_sb3_model

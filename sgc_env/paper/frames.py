@@ -67,8 +67,8 @@ from typing import Any, NamedTuple, cast
 import numpy as np
 
 from sgc_env.paper.course import CourseProfile, HermiteProfile, HoldProfile
-from sgc_env.paper.hermite import RestQuarticProfile
 from sgc_env.paper.end_rules import END_RULES
+from sgc_env.paper.hermite import RestQuarticProfile
 
 Vec3 = tuple[float, float, float]
 Rows = tuple[Vec3, Vec3, Vec3]

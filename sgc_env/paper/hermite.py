@@ -107,7 +107,8 @@ class RestQuarticProfile(Evaluated):
         T = self.duration
         c1 = -(self.v0 + 3.0 * self.d0 / T) / T**3
         c0 = (4.0 * self.d0 + self.v0 * T) / T**3
-        return u**3 * (c0 + c1 * u), -(3.0 * c0 * u**2 + 4.0 * c1 * u**3), 6.0 * c0 * u + 12.0 * c1 * u**2
+        d = u**3 * (c0 + c1 * u)
+        return d, -(3.0 * c0 * u**2 + 4.0 * c1 * u**3), 6.0 * c0 * u + 12.0 * c1 * u**2
 
 
 @dataclass(frozen=True)

@@ -19,24 +19,32 @@ Orientation tracks match the world angular acceleration ``omega_dot`` (through t
 Jacobian at each course start), position tracks the tracked point's acceleration. The first
 course starts from the measured state and the last ends with the track's given velocity, so
 those two ends are not matched. Where the solver does not reduce the largest mismatch, the
-tangent rule's velocities are kept (reported by ``MatchedEnds.converged``).
+tangent rule's velocities are kept, and so they are where the solution's planned kink (the
+largest change of ``D''`` between samples a control period apart, over the track) is not below
+the tangent plan's: matching at the goals can cost a larger jerk inside the courses.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 from scipy.sparse import lil_matrix
 
-from sgc_env.paper.frames import FrameCourse, course_end_velocity, solve_course_in_frame
+from sgc_env.paper.frames import Rows, _component_profiles, _mul, _mul_t, course_end_velocity
 from sgc_env.paper.orientation import angular_acceleration, left_jacobian_inverse_apply
 
 __all__ = ["MATCH_TOLERANCE", "MatchedEnds", "matched_end_velocities"]
 
-MAX_EVALUATIONS = 40
+_IDENTITY: Rows = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+KINK_STEP = 1.0 / 60.0
+"""Sample spacing of the planned-kink check (s): the env's control period by default."""
+
+MAX_EVALUATIONS = 20
 """Solver iterations at most: a track that does not match by then keeps its best compromise
 (measured: the matching tracks of the three-rod scenes converge in 5-10)."""
 
@@ -106,27 +114,38 @@ def matched_end_velocities(
             return velocity
         return np.array(left_jacobian_inverse_apply(s[i], velocity))
 
-    def course(i: int, ends: np.ndarray) -> FrameCourse:
-        v_in = start_rate(i, w0 if i == 0 else ends[i - 1])
-        return solve_course_in_frame(
-            frames[i], s[i], v_in, float(t[i]), ends[i], smooth_rest=i < m - 1
-        )
+    rows: list[Rows] = [
+        _IDENTITY if f is None else cast(Rows, tuple(tuple(r) for r in f.tolist())) for f in frames
+    ]
+    local = [_mul(rows[i], tuple(s[i].tolist())) for i in range(m)]
 
-    def acceleration(c: FrameCourse, at: float, i: int) -> np.ndarray:
-        d, v, a = c.state(at)
-        return angular_acceleration(d, v, a) if orientation else a
+    def course(i: int, ends: np.ndarray) -> tuple:
+        """Course ``i``'s component profiles in ``S_i`` (plain floats: the solver's inner loop)."""
+        v_in = start_rate(i, w0 if i == 0 else ends[i - 1])
+        return _component_profiles(
+            local[i], _mul(rows[i], tuple(v_in.tolist())), _mul(rows[i], tuple(ends[i].tolist())),
+            float(t[i]), i < m - 1,
+        )  # fmt: skip
+
+    def acceleration(c: tuple, at: float, i: int) -> np.ndarray:
+        s0, s1, s2 = (p.state(at) for p in c)
+        a = np.array(_mul_t(rows[i], (s0[2], s1[2], s2[2])))
+        if not orientation:
+            return a
+        d = _mul_t(rows[i], (s0[0], s1[0], s2[0]))
+        return angular_acceleration(d, _mul_t(rows[i], (s0[1], s1[1], s2[1])), a)
 
     def residual(x: np.ndarray) -> np.ndarray:
         ends = guess.copy()
         ends[list(free)] = x.reshape(-1, 3)
-        cache: dict[int, FrameCourse] = {}
+        cache: dict[int, tuple] = {}
         out = []
         for i in free:
             for j in (i, i + 1):
                 if j not in cache:
                     cache[j] = course(j, ends)
-            c, n = cache[i], cache[i + 1]
-            out.append(acceleration(c, c.duration, i) - acceleration(n, 0.0, i + 1))
+            jump = acceleration(cache[i], float(t[i]), i) - acceleration(cache[i + 1], 0.0, i + 1)
+            out.append(jump)
         return np.concatenate(out)
 
     if not free:
@@ -143,8 +162,20 @@ def matched_end_velocities(
         max_nfev=MAX_EVALUATIONS,
     )  # fmt: skip
     after = float(np.abs(residual(sol.x)).max())
-    if not after < before:
-        return MatchedEnds(guess, free, before, before)
     out = guess.copy()
     out[list(free)] = sol.x.reshape(-1, 3)
+
+    def planned_kink(ends: np.ndarray) -> float:
+        """Largest change of the planned ``D''`` between samples ``KINK_STEP`` apart."""
+        acc = []
+        for i in range(m):
+            c = course(i, ends)
+            n = max(1, int(round(float(t[i]) / KINK_STEP)))
+            for tk in np.linspace(float(t[i]) / n, float(t[i]), n):
+                s0, s1, s2 = (p.state(float(tk)) for p in c)
+                acc.append(_mul_t(rows[i], (s0[2], s1[2], s2[2])))
+        return float(np.max(np.linalg.norm(np.diff(np.array(acc), axis=0), axis=1)))
+
+    if not (after < before and planned_kink(out) < planned_kink(guess)):
+        return MatchedEnds(guess, free, before, before)
     return MatchedEnds(out, free, before, after)
