@@ -91,7 +91,7 @@ class SGCExpert:
         self.end_rule = end_rule
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
         self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
-        self._courses: dict[tuple[float, ...], tuple[tuple, tuple, bool]] = {}
+        self._courses: dict[tuple[float, ...], tuple[tuple, tuple, bool, bool]] = {}
 
     def predict(
         self,
@@ -186,30 +186,33 @@ class SGCExpert:
     def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
         """The re-solved rest of the current course, one control period ahead.
 
-        Under the matched rule the observed rate is first moved ``period / (n + 1)`` along
+        On a solved matched track the observed rate is first moved ``period / (n + 1)`` along
         the course's acceleration (``n``: physics substeps per control period, see
         :func:`substep_lag`): a course re-solved every tick from the observed rate drifts off
         its plan otherwise (0.15 m over the teal rod's 1.47 s course), and the acceleration it
-        reaches at the goal is then not the one the next course starts with.
+        reaches at the goal is then not the one the next course starts with. Not where the
+        acceleration jumps at goals (the other rules, unsolved tracks): there the first tick of
+        a course would be moved along the wrong acceleration (measured: a somersault rod's
+        angular kink 81 -> 119 rad/s²).
         """
         key = tuple(o[track.course : track.course + COURSE_SIZE])
-        rule = self.end_rule or self.model.end_rule
-        rule_is_matched = rule == "matched"
         course = self._courses.get(key)
         if course is None:
+            rule = self.end_rule or self.model.end_rule
             matched = self._matched(key) if rule == "matched" and key[12] <= 0.5 else None
             course = _course_constants(key, "tangent" if rule == "matched" else rule, matched)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
-        end_velocity, rows, smooth_rest = course
-        lag = substep_lag(period, self.model.substeps) if rule_is_matched else 0.0
+        end_velocity, rows, smooth_rest, solved = course
+        lag = substep_lag(period, self.model.substeps) if solved else 0.0
         return next_deviation(
             rows, deviation, rate, time_left, end_velocity, period, smooth_rest, lag
         )
 
-    def _matched(self, key: tuple[float, ...]) -> tuple[float, float, float] | None:
-        """The matched end velocity of an interior course, or None for an unknown course."""
+    def _matched(self, key: tuple[float, ...]) -> tuple[tuple[float, float, float], bool] | None:
+        """The matched end velocity of an interior course and whether its track was solved,
+        or None for an unknown course."""
         lookup = course_key(key)
         if self._table is None or (lookup not in self._table and self._env is not None):
             scenario = self._scenario if self._env is None else base_env(self._env).scenario
@@ -232,10 +235,12 @@ def substep_lag(period: float, substeps: int) -> float:
 
 
 def _course_constants(
-    key: tuple[float, ...], rule: str, matched: tuple[float, float, float] | None = None
-) -> tuple[tuple, tuple, bool]:
-    """World end velocity, ``S_i`` rows and whether the course arrives at rest on the
-    quartic (a matched course before a dwell) from its observation entries."""
+    key: tuple[float, ...], rule: str,
+    matched: tuple[tuple[float, float, float], bool] | None = None,
+) -> tuple[tuple, tuple, bool, bool]:  # fmt: skip
+    """World end velocity, ``S_i`` rows, whether the course arrives at rest on the quartic
+    (a matched course before a dwell) and whether it is on a solved matched track, from its
+    observation entries."""
     start, duration, nxt, next_duration, end_velocity = (
         key[0:3], key[3], key[4:7], key[7], key[8:11]
     )  # fmt: skip
@@ -246,5 +251,6 @@ def _course_constants(
     )  # fmt: skip
     rows = _IDENTITY_ROWS if info.frame is None else tuple(map(tuple, info.frame.tolist()))
     if matched is None:
-        return tuple(velocity.tolist()), rows, False
-    return matched, rows, matched == _ZERO3 and info.rule in ("rest", "dwell")
+        return tuple(velocity.tolist()), rows, False, False
+    end, solved = matched
+    return end, rows, end == _ZERO3 and info.rule in ("rest", "dwell"), solved

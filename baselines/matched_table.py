@@ -26,7 +26,8 @@ EXPERT_RULES: tuple[str, ...] = ("tangent", "paper", "matched")
 """End rules the expert plays: the scenario's two (:data:`sgc_env.paper.end_rules.END_RULES`)
 and ``"matched"``, which needs the scenario's whole tracks."""
 
-MatchedTable = dict[tuple[float, ...], tuple[float, float, float]]
+MatchedTable = dict[tuple[float, ...], tuple[tuple[float, float, float], bool]]
+"""Course key -> (end velocity, whether it was solved rather than the tangent rule's)."""
 
 
 def course_key(values: Sequence[float]) -> tuple[float, ...]:
@@ -40,7 +41,8 @@ def _track_rows(track: Track, k: int) -> list[float]:
 
 
 def matched_table(scenario: Scenario) -> MatchedTable:
-    """Course key -> matched end velocity (world) of every interior course of every track."""
+    """Course key -> matched end velocity (world) of every interior course of every track, and
+    whether its track was solved (else it holds the tangent rule's velocities)."""
     table: MatchedTable = {}
     for body, tracks in zip(scenario.bodies, compile_tracks(scenario), strict=True):
         omega = np.asarray(body.angular_velocity, float)
@@ -58,5 +60,6 @@ def matched_table(scenario: Scenario) -> MatchedTable:
             )  # fmt: skip
             for k in range(track.size - 1):
                 v = ends.velocities[k]
-                table[course_key(_track_rows(track, k))] = (float(v[0]), float(v[1]), float(v[2]))
+                velocity = (float(v[0]), float(v[1]), float(v[2]))
+                table[course_key(_track_rows(track, k))] = (velocity, ends.solved)
     return table

@@ -62,6 +62,9 @@ class MatchedEnds:
     free: tuple[int, ...]
     mismatch_before: float
     mismatch: float
+    solved: bool = True
+    """False where the tangent rule's velocities were kept (no goal to match, or solving did
+    not lower the mismatch and the planned kink)."""
 
     @property
     def converged(self) -> bool:
@@ -149,7 +152,7 @@ def matched_end_velocities(
         return np.concatenate(out)
 
     if not free:
-        return MatchedEnds(guess, free, 0.0, 0.0)
+        return MatchedEnds(guess, free, 0.0, 0.0, solved=False)
     x0 = guess[list(free)].ravel()
     before = float(np.abs(residual(x0)).max())
     n = len(free)
@@ -177,5 +180,5 @@ def matched_end_velocities(
         return float(np.max(np.linalg.norm(np.diff(np.array(acc), axis=0), axis=1)))
 
     if not (after < before and planned_kink(out) < planned_kink(guess)):
-        return MatchedEnds(guess, free, before, before)
+        return MatchedEnds(guess, free, before, before, solved=False)
     return MatchedEnds(out, free, before, after)
