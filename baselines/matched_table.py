@@ -17,7 +17,6 @@ import numpy as np
 
 from sgc_env.envs.tracks import Track, compile_tracks
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.matched import matched_end_velocities
 from sgc_env.scenario import Scenario
 
 __all__ = ["EXPERT_RULES", "course_key", "matched_table"]
@@ -43,6 +42,8 @@ def _track_rows(track: Track, k: int) -> list[float]:
 def matched_table(scenario: Scenario) -> MatchedTable:
     """Course key -> matched end velocity (world) of every interior course of every track, and
     whether its track was solved (else it holds the tangent rule's velocities)."""
+    from sgc_env.paper.matched import matched_end_velocities  # scipy.optimize: only when used
+
     table: MatchedTable = {}
     for body, tracks in zip(scenario.bodies, compile_tracks(scenario), strict=True):
         omega = np.asarray(body.angular_velocity, float)

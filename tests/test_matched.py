@@ -105,3 +105,22 @@ def test_expert_matched_meets_every_goal_and_needs_its_scenario():
         assert card["position_error_max"] < GOAL_TOLERANCE
         assert card["orientation_error_max"] < GOAL_TOLERANCE
         assert math.isfinite(card["acceleration_kink"])
+
+
+def test_episode_expert_reads_each_sub_envs_scenario():
+    """In a vector env every sub-env draws its own scenario: each sub-env's expert looks its
+    courses up in its own table, so no course falls back to the tangent rule."""
+    from baselines.policies import make_policy
+
+    envs = gym.vector.SyncVectorEnv([lambda: gym.make("SGCRod-v0") for _ in range(2)])
+    obs, _ = envs.reset(seed=[5, 6])
+    policy = make_policy("expert-matched", envs)
+    policy.predict(obs, episode_start=np.array([True, True]))
+    for i, sub in enumerate(envs.envs):
+        expert = policy._experts[i]
+        track = sub.unwrapped.task.tracks[0].position
+        key = [*track.course_start[0], track.durations[0], *track.next_start[0],
+               track.next_duration[0]]  # fmt: skip
+        assert expert._scenario is sub.unwrapped.scenario
+        assert expert._matched(tuple(np.float32(key).tolist()) + (0.0,) * 5) is not None
+    envs.close()
