@@ -153,8 +153,8 @@ def test_matched_kinks_against_minimum_jerk_what_holds():
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="expert-matched: the gold rods' angular kinks 2.9-4.4x minimum jerk's, up to 2.7x "
-    "linear where a track's solve is rejected (issue 23, docs/smoothness.md)",
+    reason="expert-matched: angular kinks up to 7.0x minimum jerk's (the first rods 2.5-4.4x), "
+    "linear up to 2.7x where a track's solve is rejected (issue 23, docs/smoothness.md)",
 )
 def test_kinks_against_minimum_jerk_every_rod_within_2x():
     """The must-show in full, with the matched rule; it does not hold yet: accelerations
