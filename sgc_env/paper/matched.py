@@ -26,6 +26,7 @@ the tangent plan's: matching at the goals can cost a larger jerk inside the cour
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import cast
 
@@ -160,10 +161,13 @@ def matched_end_velocities(
     for a in range(n):
         for b in range(max(0, a - 1), min(n, a + 2)):
             pattern[3 * a : 3 * a + 3, 3 * b : 3 * b + 3] = 1
-    sol = least_squares(
-        residual, x0, jac_sparsity=pattern, method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
-        max_nfev=MAX_EVALUATIONS,
-    )  # fmt: skip
+    try:
+        sol = least_squares(
+            residual, x0, jac_sparsity=pattern, method="trf", xtol=1e-12, ftol=1e-12,
+            gtol=1e-12, max_nfev=MAX_EVALUATIONS,
+        )  # fmt: skip
+    except ValueError:  # residuals not finite (e.g. the tangent start overflows a course)
+        return MatchedEnds(guess, free, before, before, solved=False)
     after = float(np.abs(residual(sol.x)).max())
     out = guess.copy()
     out[list(free)] = sol.x.reshape(-1, 3)
@@ -179,6 +183,6 @@ def matched_end_velocities(
                 acc.append(_mul_t(rows[i], (s0[2], s1[2], s2[2])))
         return float(np.max(np.linalg.norm(np.diff(np.array(acc), axis=0), axis=1)))
 
-    if not (after < before and planned_kink(out) < planned_kink(guess)):
+    if not (math.isfinite(after) and after < before and planned_kink(out) < planned_kink(guess)):
         return MatchedEnds(guess, free, before, before, solved=False)
     return MatchedEnds(out, free, before, after)
