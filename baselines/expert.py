@@ -20,9 +20,10 @@ import numpy as np
 
 from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
+from baselines.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
 from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.vector import base_env
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.end_rules import END_RULES
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
 
@@ -53,9 +54,15 @@ class SGCExpert:
         model: EnvModel | None = None,
         refine: bool = True,
         end_rule: str | None = None,
+        scenario: Any | None = None,
     ) -> None:
         """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
-        :mod:`sgc_env.paper.frames`); None follows the scenario (``model.end_rule``).
+        :mod:`sgc_env.paper.frames`), or ``"matched"`` (:mod:`sgc_env.paper.matched`:
+        accelerations matched over whole tracks); None follows the scenario
+        (``model.end_rule``). ``"matched"`` reads the episode's scenario (``scenario``, else
+        ``env``'s current one, re-read when a course is not found) and looks every course up
+        in its solved table (:mod:`baselines.matched_table`); a course it does not know (a
+        state of another scenario) ends by the tangent rule.
 
         ``refine``: give the torque between goals its correction step on the simulated
         rotation (goal ticks always get the exact Newton).
@@ -72,14 +79,19 @@ class SGCExpert:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
             model = EnvModel.from_env(env)
-        if end_rule is not None and end_rule not in END_RULES:
-            raise ValueError(f"end_rule must be one of {list(END_RULES)}, got {end_rule!r}")
+        if end_rule is not None and end_rule not in EXPERT_RULES:
+            raise ValueError(f"end_rule must be one of {list(EXPERT_RULES)}, got {end_rule!r}")
+        if end_rule == "matched" and env is None and scenario is None:
+            raise ValueError("end_rule='matched' needs the env or the episode's scenario")
         self.model = model
+        self._env = env
+        self._scenario = scenario
+        self._table: MatchedTable | None = None
         self.refine = refine
         self.end_rule = end_rule
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
         self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
-        self._courses: dict[tuple[float, ...], tuple[tuple, tuple]] = {}
+        self._courses: dict[tuple[float, ...], tuple[tuple, tuple, bool, bool]] = {}
 
     def predict(
         self,
@@ -172,20 +184,63 @@ class SGCExpert:
         )  # fmt: skip
 
     def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
-        """The re-solved rest of the current course, one control period ahead."""
+        """The re-solved rest of the current course, one control period ahead.
+
+        On a solved matched track the observed rate is first moved ``period / (n + 1)`` along
+        the course's acceleration (``n``: physics substeps per control period, see
+        :func:`substep_lag`): a course re-solved every tick from the observed rate drifts off
+        its plan otherwise (0.15 m over the teal rod's 1.47 s course), and the acceleration it
+        reaches at the goal is then not the one the next course starts with. Not where the
+        acceleration jumps at goals (the other rules, unsolved tracks): there the first tick of
+        a course would be moved along the wrong acceleration (measured: a somersault rod's
+        angular kink 81 -> 119 rad/s²).
+        """
         key = tuple(o[track.course : track.course + COURSE_SIZE])
         course = self._courses.get(key)
         if course is None:
-            course = _course_constants(key, self.end_rule or self.model.end_rule)
+            rule = self.end_rule or self.model.end_rule
+            matched = self._matched(key) if rule == "matched" and key[12] <= 0.5 else None
+            course = _course_constants(key, "tangent" if rule == "matched" else rule, matched)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
-        end_velocity, rows = course
-        return next_deviation(rows, deviation, rate, time_left, end_velocity, period)
+        end_velocity, rows, smooth_rest, solved = course
+        lag = substep_lag(period, self.model.substeps) if solved else 0.0
+        return next_deviation(
+            rows, deviation, rate, time_left, end_velocity, period, smooth_rest, lag
+        )
+
+    def _matched(self, key: tuple[float, ...]) -> tuple[tuple[float, float, float], bool] | None:
+        """The matched end velocity of an interior course and whether its track was solved,
+        or None for an unknown course."""
+        lookup = course_key(key)
+        if self._table is None or (lookup not in self._table and self._env is not None):
+            scenario = self._scenario if self._env is None else base_env(self._env).scenario
+            if scenario is not None and (self._table is None or scenario is not self._scenario):
+                self._scenario = scenario
+                self._table = matched_table(scenario)
+        return None if self._table is None else self._table.get(lookup)
 
 
-def _course_constants(key: tuple[float, ...], rule: str) -> tuple[tuple, tuple]:
-    """World end velocity and ``S_i`` rows of a course from its observation entries."""
+def substep_lag(period: float, substeps: int) -> float:
+    """How far behind the plan's rate an observed rate is, as a ``lag`` for
+    :func:`~sgc_env.paper.frames.next_deviation`.
+
+    A force held over ``n`` semi-implicit substeps of ``h = H / n`` that lands the body on
+    the plan's next sample moves it by ``H v + (n + 1) / (2 n) H^2 a``, so the velocity it
+    leaves with is ``D' + n / (n + 1) H D''`` where the plan has ``D' + H D''``: behind by
+    ``H D'' / (n + 1)``, i.e. the mean over the last ``2 H / (n + 1)`` seconds.
+    """
+    return 2.0 * period / (substeps + 1)
+
+
+def _course_constants(
+    key: tuple[float, ...], rule: str,
+    matched: tuple[tuple[float, float, float], bool] | None = None,
+) -> tuple[tuple, tuple, bool, bool]:  # fmt: skip
+    """World end velocity, ``S_i`` rows, whether the course arrives at rest on the quartic
+    (a matched course before a dwell) and whether it is on a solved matched track, from its
+    observation entries."""
     start, duration, nxt, next_duration, end_velocity = (
         key[0:3], key[3], key[4:7], key[7], key[8:11]
     )  # fmt: skip
@@ -195,4 +250,7 @@ def _course_constants(key: tuple[float, ...], rule: str) -> tuple[tuple, tuple]:
         end_velocity=end_velocity if is_last else None, rule=rule,
     )  # fmt: skip
     rows = _IDENTITY_ROWS if info.frame is None else tuple(map(tuple, info.frame.tolist()))
-    return tuple(velocity.tolist()), rows
+    if matched is None:
+        return tuple(velocity.tolist()), rows, False, False
+    end, solved = matched
+    return end, rows, end == _ZERO3 and info.rule in ("rest", "dwell"), solved

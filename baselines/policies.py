@@ -1,7 +1,9 @@
 """One way to name a policy: ``make_policy(spec, env)`` for the CLI and the evaluation harness.
 
 Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tangent rule),
-``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``dynamic-constraints``,
+``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``expert-matched`` (SGC with
+end velocities solved over whole tracks so accelerations match, :mod:`sgc_env.paper.matched`),
+``dynamic-constraints``,
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
 :mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
@@ -30,6 +32,7 @@ from baselines.comparison_policies import (
     episode_model,
     observation_tick,
     predict_per_env,
+    scenario_of,
 )
 from baselines.expert import SGCExpert
 from baselines.model_files import algorithm_from_data, load_sb3_model
@@ -52,7 +55,7 @@ __all__ = [
 ]
 
 BUILTIN_POLICIES: tuple[str, ...] = (
-    "expert", "expert-paper", "dynamic-constraints", "minimum-jerk", "random"
+    "expert", "expert-paper", "expert-matched", "dynamic-constraints", "minimum-jerk", "random"
 )  # fmt: skip
 _TRUST_MODELS: contextvars.ContextVar[bool] = contextvars.ContextVar("trust_models", default=False)
 
@@ -126,7 +129,8 @@ class EpisodeExpert:
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
                 model = episode_model(self.env, i)
-                self._experts[i] = SGCExpert(model=model, end_rule=self.end_rule)
+                scenario = scenario_of(self.env, i) if self.end_rule == "matched" else None
+                self._experts[i] = SGCExpert(model=model, end_rule=self.end_rule, scenario=scenario)
             return self._experts[i].action(row)
 
         return predict_per_env(observation, episode_start, row_action), state
@@ -249,12 +253,14 @@ def make_policy(
     spec = resolve_policy_spec(spec)
     if spec == "random":
         return RandomPolicy(_spaces_env(env).action_space, seed)
-    if spec in ("expert", "expert-paper", "dynamic-constraints", "minimum-jerk"):
+    if spec in ("expert", "expert-paper", "expert-matched", "dynamic-constraints", "minimum-jerk"):
         _needs_flat_observation(env, spec)
         if spec == "expert":
             return EpisodeExpert(env)
         if spec == "expert-paper":
             return EpisodeExpert(env, end_rule="paper")
+        if spec == "expert-matched":
+            return EpisodeExpert(env, end_rule="matched")
         if spec == "dynamic-constraints":
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)

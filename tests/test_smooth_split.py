@@ -113,7 +113,7 @@ def test_rollout_and_evaluate_report_the_angular_figures(tmp_path, capsys):
         assert math.isfinite(summary[key]), key
 
 
-def _kink_rows(episodes: int) -> list[dict]:
+def _kink_rows(episodes: int, policy: str = "expert") -> list[dict]:
     import importlib.util
     from pathlib import Path
 
@@ -122,8 +122,8 @@ def _kink_rows(episodes: int) -> list[dict]:
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    rows = module.compare("SGCThreeRods-v1", 1, 0, "expert")
-    return rows + module.compare("SGCThreeRodsRandom-v2", episodes, 10000, "expert")
+    rows = module.compare("SGCThreeRods-v1", 1, 0, policy)
+    return rows + module.compare("SGCThreeRodsRandom-v2", episodes, 10000, policy)
 
 
 @pytest.mark.slow
@@ -139,12 +139,30 @@ def test_kinks_against_minimum_jerk_what_holds():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="angular kinks at goals: 3-17x minimum jerk's (issue 23)")
+def test_matched_kinks_against_minimum_jerk_what_holds():
+    """The matched rule (expert-matched): every goal met; on the paper's scene every rod's
+    linear kink and the teal and violet rods' angular kinks within 2x of minimum jerk's; no
+    random rod's linear kink beyond 3x (docs/smoothness.md, scripts/kink_table.py)."""
+    rows = _kink_rows(5, "expert-matched")
+    assert all(r["met"] == r["goals"] for r in rows)
+    assert max(r["acceleration_kink_ratio"] for r in rows[:3]) <= 2.0
+    assert max(r["angular_acceleration_kink_ratio"] for r in rows[1:3]) <= 2.0
+    assert max(r["acceleration_kink_ratio"] for r in rows) <= 3.0
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="expert-matched: angular kinks up to 7.0x minimum jerk's (the first rods 2.5-4.4x), "
+    "linear up to 2.7x where a track's solve is rejected (issue 23, docs/smoothness.md)",
+)
 def test_kinks_against_minimum_jerk_every_rod_within_2x():
-    """The must-show in full; it does not hold yet: SGC courses are C1 at goals and a stateless
-    expert sees only two courses, so the acceleration jumps at orientation goals
-    (docs/smoothness.md)."""
-    rows = _kink_rows(5)
+    """The must-show in full, with the matched rule; it does not hold yet: accelerations
+    match at the goals, but where the goal times ask for a large change of pace (the gold
+    rods' courses of 1.1 rad in 0.25 s between slower ones) an SGC course's own jerk stays
+    2-4x minimum jerk's, and tracks whose solve does not lower the planned kink keep the
+    tangent rule (docs/smoothness.md)."""
+    rows = _kink_rows(5, "expert-matched")
     for r in rows:
         assert r["acceleration_kink_ratio"] <= 2.0
         assert r["angular_acceleration_kink_ratio"] <= 2.0

@@ -68,13 +68,14 @@ import numpy as np
 
 from sgc_env.paper.course import CourseProfile, HermiteProfile, HoldProfile
 from sgc_env.paper.end_rules import END_RULES
+from sgc_env.paper.hermite import RestQuarticProfile
 
 Vec3 = tuple[float, float, float]
 Rows = tuple[Vec3, Vec3, Vec3]
 """A frame ``S_i`` as three row tuples (world unit vectors)."""
 Vector = Sequence[float] | np.ndarray
 """A 3-vector as any sequence of floats or an array."""
-Profile = CourseProfile | HermiteProfile | HoldProfile
+Profile = CourseProfile | HermiteProfile | HoldProfile | RestQuarticProfile
 
 __all__ = [
     "C_HIGH",
@@ -450,6 +451,8 @@ def solve_course_in_frame(
     velocity_now: Vector,
     time_left: float,
     end_velocity: Vector,
+    *,
+    smooth_rest: bool = False,
 ) -> FrameCourse:
     """Solve the rest of a course from the current state (what a stateless expert calls).
 
@@ -462,7 +465,8 @@ def solve_course_in_frame(
     speed, e.g. 1e-30 m approached at 1 m/s). ``k'`` is not clamped to
     ``k_min`` here: that would break time consistency (``k_min`` applies at course start).
     A zero deviation, velocity and end velocity gives the dwell (:class:`HoldProfile`).
-    ``frame`` None means the world frame.
+    ``frame`` None means the world frame. ``smooth_rest`` (the ``"matched"`` rule): arrive at
+    rest on a :class:`RestQuarticProfile` (zero end acceleration) instead of the cubic.
     """
     if not (math.isfinite(time_left) and time_left > 0.0):
         raise ValueError(f"time_left must be finite and > 0, got {time_left!r}")
@@ -476,36 +480,49 @@ def solve_course_in_frame(
         _mul(rows, _vec3(velocity_now, "velocity_now")),
         _mul(rows, _vec3(end_velocity, "end_velocity")),
         time_left,
+        smooth_rest,
     )
     return FrameCourse(rows, profiles, time_left)
 
 
 def next_deviation(
     rows: Rows, deviation_now: Vec3, velocity_now: Vec3, time_left: float, end_velocity: Vec3,
-    t: float,
+    t: float, smooth_rest: bool = False, lag: float = 0.0,
 ) -> Vec3:  # fmt: skip
     """World ``D(t)`` of the course :func:`solve_course_in_frame` would return, in plain floats.
 
     ``rows``: ``S_i`` as three row tuples (the identity for a dwell), the 3-vectors as tuples
     of floats; no validation beyond :meth:`CourseProfile.solve`'s. The expert calls this every
     control step; it shares the per-component rules with :func:`solve_course_in_frame`.
+    ``lag``: the velocity is the mean over the last ``lag`` seconds (a semi-implicit step's
+    chord), so the course is re-solved once from ``velocity_now + lag/2 D''(now)``.
     """
     if not time_left > 0.0:
         raise ValueError(f"time_left must be > 0, got {time_left!r}")
-    p0, p1, p2 = _component_profiles(
-        _mul(rows, deviation_now), _mul(rows, velocity_now), _mul(rows, end_velocity), time_left
-    )
+    d, v, ve = _mul(rows, deviation_now), _mul(rows, velocity_now), _mul(rows, end_velocity)
+    p0, p1, p2 = _component_profiles(d, v, ve, time_left, smooth_rest)
+    if lag > 0.0:  # ``velocity_now`` is the mean over the last ``lag`` s: centre it on now
+        half = 0.5 * lag
+        v = (v[0] + half * p0.state(0.0)[2], v[1] + half * p1.state(0.0)[2],
+             v[2] + half * p2.state(0.0)[2])  # fmt: skip
+        p0, p1, p2 = _component_profiles(d, v, ve, time_left, smooth_rest)
     return _mul_t(rows, (p0.state(t)[0], p1.state(t)[0], p2.state(t)[0]))
 
 
 def _component_profiles(
-    d: Vec3, v: Vec3, ve: Vec3, time_left: float
+    d: Vec3, v: Vec3, ve: Vec3, time_left: float, smooth_rest: bool = False
 ) -> tuple[Profile, Profile, Profile]:
     """The three component profiles of a course in ``S_i`` (components given in ``S_i``)."""
     rest = ve == _ZERO3
     if rest and d == _ZERO3 and v == _ZERO3:
         hold = HoldProfile(time_left)
         return hold, hold, hold
+    if rest and smooth_rest:
+        return (
+            RestQuarticProfile(d[0], v[0], time_left),
+            RestQuarticProfile(d[1], v[1], time_left),
+            RestQuarticProfile(d[2], v[2], time_left),
+        )
     return (
         _component_profile(d[0], v[0], ve[0], time_left, rest),
         _component_profile(d[1], v[1], ve[1], time_left, rest),

@@ -14,7 +14,7 @@ Num = float | np.ndarray
 Floats3 = tuple[float, float, float]
 Arrays3 = tuple[np.ndarray, np.ndarray, np.ndarray]
 
-__all__ = ["Evaluated", "HermiteProfile", "HoldProfile"]
+__all__ = ["Evaluated", "HermiteProfile", "HoldProfile", "RestQuarticProfile"]
 
 
 def _like(value: np.ndarray, t: float | np.ndarray) -> float | np.ndarray:
@@ -77,6 +77,38 @@ class HermiteProfile(Evaluated):
         v = d0 * (6 * s**2 - 6 * s) + m0 * (3 * s**2 - 4 * s + 1) + m1 * (3 * s**2 - 2 * s)
         a = d0 * (12 * s - 6) + m0 * (6 * s - 4) + m1 * (6 * s - 2)
         return d, v / T, a / (T * T)
+
+
+@dataclass(frozen=True)
+class RestQuarticProfile(Evaluated):
+    """Quartic course from ``(d0, v0)`` to rest with zero acceleration: ``D = u^3 (c0 + c1 u)``,
+    ``u = T - t``.
+
+    The ``"matched"`` end rule's arrival at rest (before a dwell, or a last goal reached at
+    rest): the cubic ends with a jump of acceleration into the hold, the quartic does not.
+    Five conditions fix the quartic, so re-fitting from a state on it returns it
+    (time-consistent, like the cubic).
+    """
+
+    d0: float
+    v0: float
+    duration: float
+    branch: str = "rest-quartic"
+
+    def state(self, t: float) -> tuple[float, float, float]:
+        """``(D, D', D'')`` at scalar ``t`` (plain floats: the expert's per-step path)."""
+        return cast(Floats3, self._quartic(self.duration - float(t)))
+
+    def evaluate(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(D, D', D'')`` at ``t`` seconds from the course start."""
+        return cast(Arrays3, self._quartic(self.duration - np.asarray(t, dtype=float)))
+
+    def _quartic(self, u: Num) -> tuple[Num, Num, Num]:
+        T = self.duration
+        c1 = -(self.v0 + 3.0 * self.d0 / T) / T**3
+        c0 = (4.0 * self.d0 + self.v0 * T) / T**3
+        d = u**3 * (c0 + c1 * u)
+        return d, -(3.0 * c0 * u**2 + 4.0 * c1 * u**3), 6.0 * c0 * u + 12.0 * c1 * u**2
 
 
 @dataclass(frozen=True)

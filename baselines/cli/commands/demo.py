@@ -55,8 +55,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     who = parser.add_mutually_exclusive_group()
     who.add_argument(
         "--policy", default="expert", metavar="SPEC",
-        help="the policy that flies the demo: expert | expert-paper | minimum-jerk | "
-        "dynamic-constraints | random | shipped:<stem> | SB3 .zip (default expert)",
+        help="the policy that flies the demo: expert | expert-paper | expert-matched | "
+        "minimum-jerk | dynamic-constraints | random | shipped:<stem> | SB3 .zip (default expert)",
     )  # fmt: skip
     who.add_argument(
         "--compare", metavar="A,B", default=None,
