@@ -11,6 +11,12 @@ conventions and in how they batch what this returns.
 A sub-env that does not step in a call (it is being reset) still has bodies in the world that
 the substeps integrate; its reset comes after the physics and overwrites their state, so it
 starts exactly where a single env's reset would.
+
+Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one) step by the fast path,
+:meth:`Batch.step_fast`: the task work of all sub-envs at once in numpy
+(:class:`~sgc_env.envs.batch_task.BatchTask`), the sub-env objects brought up to date only
+when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
+``_finish_step`` (:meth:`Batch.step`).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ import numpy as np
 from sgc_env.episode_steps import check_episode_length
 
 from .actuation import clip_action
+from .batch_task import BatchTask, GoalEvent
 from .sgc_env import SGCEnv
 from .world import SharedWorld
 
@@ -63,35 +70,58 @@ class Batch:
         if kwargs.get("render_mode") is not None:
             raise ValueError("render_mode: the batched env does not render; use a single env")
         self.world = SharedWorld(int(kwargs.get("sim_frequency", 240)))
-        self.envs: list[SGCEnv] = []
+        self._envs: list[SGCEnv] = []
+        self.closed = False
         try:
             for _ in range(n):
-                self.envs.append(env_class(**kwargs, world=self.world))
+                self._envs.append(env_class(**kwargs, world=self.world))
         except BaseException:
             self.close()
             raise
-        first = self.envs[0]
+        first = self._envs[0]
         self.substeps = first.substeps
         self.action_shape: tuple[int, ...] = first._action_shape
         self.limit = (
             None if max_episode_steps is None or max_episode_steps == -1 else int(max_episode_steps)
         )
         self.env_id = env_id
-        self.elapsed = [0] * n
-        self.closed = False
+        self.elapsed = np.zeros(n, dtype=np.int64)
+        self.fast = (
+            BatchTask(self._envs, self.world.client) if env_class is SGCEnv else None
+        )
+        self._behind = False  # the sub-env objects lag the fast path's arrays
+        self._handed = False  # the sub-envs were handed out: reload the arrays from them
 
     def __len__(self) -> int:
-        return len(self.envs)
+        return len(self._envs)
+
+    @property
+    def envs(self) -> list[SGCEnv]:
+        """The sub-envs, up to date (read them through this property each time: between
+        calls the fast path keeps their per-step state in its arrays)."""
+        fast = self.fast
+        if fast is not None:
+            if self._behind:
+                for i in range(len(self._envs)):
+                    fast.sync(i)
+                self._behind = False
+            self._handed = True
+        return self._envs
 
     def reset_one(
         self, i: int, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         """Reset sub-env ``i`` (refusing an episode its time limit would cut short)."""
-        env = self.envs[i]
+        env = self._envs[i]
+        if self._behind and self.fast is not None:
+            self.fast.sync(i)  # what a failed reset leaves must be the sub-env's own state
         try:
             obs, info = env.reset(seed=seed, options=options)
         except ValueError as err:
             raise ValueError(f"sub-env {i}: {err}") from err
+        finally:
+            if self.fast is not None:
+                self.fast.load(i)
         if self.env_id is not None:
             check_episode_length(self.env_id, self.limit, env.max_steps)
         self.elapsed[i] = 0
@@ -99,25 +129,50 @@ class Batch:
 
     def clip(self, actions: Any, indices: list[int]) -> list[list[float]]:
         """Each listed sub-env's action row, clipped; errors name the sub-env."""
+        return self.clip_rows(actions, indices).tolist()
+
+    def clip_rows(self, actions: Any, indices: list[int]) -> np.ndarray:
+        """:meth:`clip` as an array (rows, action) of the action's dtype."""
         a = actions if type(actions) is np.ndarray else np.asarray(actions)
-        shape = (len(self.envs), *self.action_shape)
+        shape = (len(self._envs), *self.action_shape)
         if a.shape != shape:
             raise ValueError(f"actions have shape {a.shape}, expected {shape} (num_envs, action)")
         rows = a[indices]
         if a.dtype.kind in "fiu" and np.isfinite(rows).all():
-            return np.clip(rows, -1, 1).tolist()  # as clip_action, one call for all rows
+            return np.clip(rows, -1, 1)  # as clip_action, one call for all rows
         out = []  # something is wrong: find the first bad row with the single env's check
         for i in indices:
             try:
                 out.append(clip_action(a[i], self.action_shape))
             except (TypeError, ValueError) as err:
                 raise type(err)(f"sub-env {i}: {err}") from None
-        return out
+        return np.array(out)
+
+    def step_fast(
+        self, indices: list[int], actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, list[GoalEvent]]]:
+        """:meth:`step` by the fast path (plain ``SGCEnv`` sub-envs): rewards, terminated and
+        truncated over all sub-envs (rows not listed hold stale values: reset them next) and
+        the goal events by sub-env; observations and records in ``fast.obs`` / ``fast.rec``."""
+        fast = self.fast
+        assert fast is not None
+        values = self.clip_rows(actions, indices).astype(np.float64)
+        if self._handed:  # a sub-env may have been pushed or changed: start from the objects
+            for i in range(len(self._envs)):
+                fast.load(i, record=False)
+            self._handed = False
+        rewards, terminated, at_limit, events = fast.step(indices, values)
+        self._behind = True
+        truncated = ~terminated & at_limit
+        self.elapsed[indices] += 1
+        if self.limit is not None:
+            truncated |= self.elapsed >= self.limit
+        return rewards, terminated, truncated, events
 
     def step(self, indices: list[int], values: list[list[float]]) -> list[StepResult]:
         """One control step of the listed sub-envs (their clipped actions) in one world step;
         the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
-        envs = self.envs
+        envs = self._envs
         drives: list[Any] = []
         moves: list[list[Any]] = [[] for _ in range(self.substeps)]
         any_moves = False
@@ -142,7 +197,7 @@ class Batch:
 
     def close(self) -> None:
         """Close every sub-env and free the client (idempotent)."""
-        for env in self.envs:
+        for env in self._envs:
             env.close()
         self.world.close()
         self.closed = True
