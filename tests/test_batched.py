@@ -12,6 +12,7 @@ import pytest
 import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
+from sgc_env.envs import batch as batch_module
 from sgc_env.envs.rewards import REWARD_MODES
 from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
 
@@ -180,3 +181,23 @@ def test_gymnasium_conventions() -> None:
             vec.render()
     finally:
         vec.close()
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1", "SGCPointGoal-v0"])
+def test_sharded_worlds_equal_single_envs(env_id: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Scenes spread over several PyBullet worlds (one scene each here) step as single envs."""
+    monkeypatch.setattr(batch_module, "SHARD_OBJECTS", 1)
+    vec = make_vec(env_id, 3)
+    try:
+        assert len(vec.unwrapped._batch.worlds) == 3
+    finally:
+        vec.close()
+    n, steps = SIZES.get(env_id, (3, 120))
+    assert run_pair(env_id, n, steps, max_episode_steps=30) >= 2
+
+
+def test_scenes_per_world() -> None:
+    assert batch_module.scenes_per_world(64, 1) == 16  # 16 objects per world
+    assert batch_module.scenes_per_world(8, 7) == 2
+    assert batch_module.scenes_per_world(256, 7) == 8  # at most MAX_WORLDS (32) worlds
+    assert batch_module.scenes_per_world(4, 40) == 1

@@ -32,7 +32,8 @@ from .batch_task import BatchTask, GoalEvent
 from .sgc_env import SGCEnv
 from .world import SharedWorld
 
-__all__ = ["MAX_ENVS", "Batch", "check_num_envs"]
+__all__ = ["MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
+           "scenes_per_world"]  # fmt: skip
 
 MAX_ENVS = 1024
 """Most sub-envs per world. Why a cap: memory stays near 1 GB for three-rod scenes (~1 MB each),
@@ -40,6 +41,22 @@ larger worlds were never measured, and the per-step cost only grows with N (in
 scripts/bench_vec.py runs 256 rods were already slower per env-step than 64)."""
 
 StepResult = tuple[Any, float, bool, bool, Any]
+
+
+SHARD_OBJECTS = 16
+"""Objects (bodies and props) per PyBullet world, about. Why shards: PyBullet's
+``stepSimulation`` costs O(objects^2) in one world even without collision shapes (measured:
+3 us per body-step at 16 bodies, 16 at 64, 58 at 256), so the batch spreads its scenes over
+several worlds (clients) of about this many objects."""
+
+MAX_WORLDS = 32
+"""Most worlds per batch: each PyBullet client holds ~28 MB, so more scenes share a world
+once N scenes would need more (a 256-scene three-rod batch: 8 scenes of 7 objects per world)."""
+
+
+def scenes_per_world(num_envs: int, objects: int) -> int:
+    """Scenes per world for ``num_envs`` scenes of ``objects`` objects each."""
+    return max(1, SHARD_OBJECTS // max(objects, 1), -(-num_envs // MAX_WORLDS))
 
 
 def check_num_envs(num_envs: object) -> int:
@@ -69,12 +86,17 @@ class Batch:
         n = check_num_envs(num_envs)
         if kwargs.get("render_mode") is not None:
             raise ValueError("render_mode: the batched env does not render; use a single env")
-        self.world = SharedWorld(int(kwargs.get("sim_frequency", 240)))
+        frequency = int(kwargs.get("sim_frequency", 240))
+        self.worlds = [SharedWorld(frequency)]
         self._envs: list[SGCEnv] = []
         self.closed = False
         try:
-            for _ in range(n):
-                self._envs.append(env_class(**kwargs, world=self.world))
+            self._envs.append(env_class(**kwargs, world=self.worlds[0]))
+            per_world = scenes_per_world(n, len(self._envs[0].sim.bodies))
+            for i in range(1, n):
+                if i % per_world == 0:
+                    self.worlds.append(SharedWorld(frequency))
+                self._envs.append(env_class(**kwargs, world=self.worlds[-1]))
         except BaseException:
             self.close()
             raise
@@ -86,9 +108,7 @@ class Batch:
         )
         self.env_id = env_id
         self.elapsed = np.zeros(n, dtype=np.int64)
-        self.fast = (
-            BatchTask(self._envs, self.world.client) if env_class is SGCEnv else None
-        )
+        self.fast = BatchTask(self._envs) if env_class is SGCEnv else None
         self._behind = False  # the sub-env objects lag the fast path's arrays
         self._handed = False  # the sub-envs were handed out: reload the arrays from them
 
@@ -113,15 +133,12 @@ class Batch:
     ) -> tuple[Any, dict[str, Any]]:
         """Reset sub-env ``i`` (refusing an episode its time limit would cut short)."""
         env = self._envs[i]
-        if self._behind and self.fast is not None:
-            self.fast.sync(i)  # what a failed reset leaves must be the sub-env's own state
         try:
             obs, info = env.reset(seed=seed, options=options)
-        except ValueError as err:
+        except ValueError as err:  # a refused reset changes nothing (the env's own rule)
             raise ValueError(f"sub-env {i}: {err}") from err
-        finally:
-            if self.fast is not None:
-                self.fast.load(i)
+        if self.fast is not None:
+            self.fast.load(i)
         if self.env_id is not None:
             check_episode_length(self.env_id, self.limit, env.max_steps)
         self.elapsed[i] = 0
@@ -173,18 +190,19 @@ class Batch:
         """One control step of the listed sub-envs (their clipped actions) in one world step;
         the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
         envs = self._envs
-        drives: list[Any] = []
-        moves: list[list[Any]] = [[] for _ in range(self.substeps)]
-        any_moves = False
+        by_world: dict[int, tuple[list[Any], list[list[Any]]]] = {}
         for i, v in zip(indices, values, strict=True):
             d, m = envs[i]._drives(v)
+            drives, moves = by_world.setdefault(
+                envs[i].sim.client, ([], [[] for _ in range(self.substeps)])
+            )
             drives += d
-            if m:
-                any_moves = True
-                for k, mk in enumerate(m):
-                    moves[k] += mk
-        if drives:
-            self.world.sim.step_bodies(drives, moves if any_moves else ())
+            for k, mk in enumerate(m):
+                moves[k] += mk
+        for world in self.worlds:
+            if world.client in by_world:
+                drives, moves = by_world[world.client]
+                world.sim.step_bodies(drives, moves if any(moves) else ())
         results = []
         limit, elapsed = self.limit, self.elapsed
         for i, v in zip(indices, values, strict=True):
@@ -199,5 +217,6 @@ class Batch:
         """Close every sub-env and free the client (idempotent)."""
         for env in self._envs:
             env.close()
-        self.world.close()
+        for world in self.worlds:
+            world.close()
         self.closed = True

@@ -1,7 +1,8 @@
-"""Elementwise numpy twins of the env's per-body float arithmetic, for the batched task.
+"""Elementwise numpy twins of the env's branching float helpers, for the batched task.
 
-Each function repeats one scalar helper (:mod:`sgc_env.paper.quaternion`, the reward costs of
-:mod:`sgc_env.envs.rewards`) on arrays of any shape, operation for operation in the scalar
+The branch-free helpers of :mod:`sgc_env.paper.quaternion` (``rotate``, ``mul_conjugate``) take
+tuples of arrays as they are; the ones with branches (``log``, ``unwrap_rotvec``, Python's
+``min``/``max``) are repeated here on arrays of any shape, operation for operation in the scalar
 code's order (numpy evaluates ``a + b * c + d`` as Python does: no reordering, no fused
 multiply-add), so each element equals the scalar result bit for bit. ``atan2``, the one
 transcendental function, goes through ``math.atan2`` per element: numpy's SIMD versions may
@@ -15,34 +16,10 @@ import math
 
 import numpy as np
 
-__all__ = ["at_most", "atan2", "log", "mul_conjugate", "norm3", "rotate", "unwrap_rotvec"]
+__all__ = ["at_least", "at_most", "atan2", "log", "norm3", "unwrap_rotvec"]
 
 Arr = np.ndarray
 TWO_PI = 2.0 * math.pi
-
-
-def rotate(x: Arr, y: Arr, z: Arr, w: Arr, vx: Arr, vy: Arr, vz: Arr) -> tuple[Arr, Arr, Arr]:
-    """:func:`sgc_env.paper.quaternion.rotate` per element."""
-    tx = 2.0 * (y * vz - z * vy)
-    ty = 2.0 * (z * vx - x * vz)
-    tz = 2.0 * (x * vy - y * vx)
-    return (
-        vx + w * tx + (y * tz - z * ty),
-        vy + w * ty + (z * tx - x * tz),
-        vz + w * tz + (x * ty - y * tx),
-    )
-
-
-def mul_conjugate(a: Arr, b: Arr) -> tuple[Arr, Arr, Arr, Arr]:
-    """:func:`sgc_env.paper.quaternion.mul_conjugate` on (..., 4) arrays, as components."""
-    ax, ay, az, aw = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    bx, by, bz, bw = b[..., 0], b[..., 1], b[..., 2], b[..., 3]
-    return (
-        -aw * bx + ax * bw - ay * bz + az * by,
-        -aw * by + ax * bz + ay * bw - az * bx,
-        -aw * bz - ax * by + ay * bx + az * bw,
-        aw * bw + ax * bx + ay * by + az * bz,
-    )
 
 
 def atan2(y: Arr, x: Arr) -> Arr:
@@ -65,9 +42,7 @@ def log(x: Arr, y: Arr, z: Arr, w: Arr) -> tuple[Arr, Arr, Arr]:
     return x * scale, y * scale, z * scale
 
 
-def unwrap_rotvec(
-    px: Arr, py: Arr, pz: Arr, rx: Arr, ry: Arr, rz: Arr
-) -> tuple[Arr, Arr, Arr]:
+def unwrap_rotvec(px: Arr, py: Arr, pz: Arr, rx: Arr, ry: Arr, rz: Arr) -> tuple[Arr, Arr, Arr]:
     """:func:`sgc_env.paper.quaternion.unwrap_rotvec` per element (``round`` is half to even,
     as ``np.rint``)."""
     angle = norm3(px, py, pz)

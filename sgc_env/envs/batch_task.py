@@ -20,20 +20,24 @@ already handed out copies them first.
 
 from __future__ import annotations
 
-import math
 import sys
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
-from sgc_env.simulator import pybullet
+from sgc_env.paper import quaternion
+from sgc_env.simulator import BodyReading, pybullet
 
 from . import batch_math as bm
 from .rewards import (
-    BONUS_ORIENTATION, BONUS_POSITION, EFFORT_WEIGHT, ORIENTATION_FLOOR, POSITION_FLOOR,
+    EFFORT_WEIGHT,
+    ORIENTATION_FLOOR,
+    POSITION_FLOOR,
     TRACK_COST_CAP,
 )  # fmt: skip
+from .rewards import _bonus as goal_bonus
 from .sgc_env import MAX_SPEED, SPIN_CLAMP, SGCEnv
 from .task import GoalEvent
 
@@ -53,8 +57,28 @@ _PHI, _OTL = _col("orientation_deviation"), _col("orientation_time_left")
 _OC = _col("orientation_course_start")
 _RES, _ORES = _col("position_deviation_residual"), _col("point_offset_residual")
 assert (_OFF, _DEV, _PV, _PTL, _PC, _PHI, _OTL, _OC, _RES, _ORES, BODY_BLOCK_SIZE) == (
-    13, 16, 19, 22, 23, 36, 39, 40, 53, 74, 77
+    13,
+    16,
+    19,
+    22,
+    23,
+    36,
+    39,
+    40,
+    53,
+    74,
+    77,
 ), "the observation layout changed: update BatchTask's record"
+
+# The scalar quaternion helpers, applied to tuples of arrays (their arithmetic is elementwise).
+rotate: Callable[..., Any] = quaternion.rotate
+mul_conjugate: Callable[..., Any] = quaternion.mul_conjugate
+
+
+def readings(rows: list[list[float]]) -> list[BodyReading]:
+    """Per body (position, orientation, velocity, angular velocity) tuples from 13-float rows."""
+    return [(tuple(r[0:3]), tuple(r[3:7]), tuple(r[7:10]), tuple(r[10:13])) for r in rows]
+
 
 _SEQUENTIAL_SUM = sys.version_info < (3, 12)  # 3.12's sum() of floats is compensated
 
@@ -62,10 +86,9 @@ _SEQUENTIAL_SUM = sys.version_info < (3, 12)  # 3.12's sum() of floats is compen
 class BatchTask:
     """The arrays and per-step arithmetic of N plain ``SGCEnv`` sub-envs (module docstring)."""
 
-    def __init__(self, envs: list[SGCEnv], client: int) -> None:
+    def __init__(self, envs: list[SGCEnv]) -> None:
         first = envs[0]
         self.envs = envs
-        self.client = client
         n, b = len(envs), first._n
         self.n, self.b = n, b
         self.size = first._obs_size
@@ -80,6 +103,9 @@ class BatchTask:
         self.state = z((n, b, 13))  # position, orientation (xyzw), velocity, angular velocity
         self.phi = z((n, b, 3))
         self.uid = z((n, b), dtype=np.int64)
+        self.client = np.array([env.sim.client for env in envs])  # each sub-env's world
+        self._clients = np.repeat(self.client, b).tolist()
+        self._worlds = sorted(set(self.client.tolist()))
         self.flimit, self.mass = z((n, b)), z((n, b))
         self.tscale, self.gravity = z((n, b, 3)), z((n, 1, 3))
         self.lo, self.hi = z((n, 1, 3)), z((n, 1, 3))
@@ -160,10 +186,7 @@ class BatchTask:
         """Write sub-env ``i``'s state into its ``SGCEnv``, as its own step would have left it."""
         env, task = self.envs[i], self.envs[i].task
         env._tick = int(self.tick[i])
-        env._states = [
-            (tuple(r[0:3]), tuple(r[3:7]), tuple(r[7:10]), tuple(r[10:13]))
-            for r in self.state[i].tolist()
-        ]
+        env._states = readings(self.state[i].tolist())
         task.points = list(map(tuple, self.point[i].tolist()))
         task.deviations = list(map(tuple, self.dev[i].tolist()))
         task.phi = list(map(tuple, self.phi[i].tolist()))
@@ -225,10 +248,10 @@ class BatchTask:
         torques = None
         if self.use_torque:
             x, y, z, w = s[..., 3], s[..., 4], s[..., 5], s[..., 6]
-            bx, by, bz = bm.rotate(-x, -y, -z, w, a[..., 3], a[..., 4], a[..., 5])
+            bx, by, bz = rotate((-x, -y, -z, w), (a[..., 3], a[..., 4], a[..., 5]))
             sc = self.tscale
             torques = np.stack(
-                bm.rotate(x, y, z, w, bx * sc[..., 0], by * sc[..., 1], bz * sc[..., 2]), axis=-1
+                rotate((x, y, z, w), (bx * sc[..., 0], by * sc[..., 1], bz * sc[..., 2])), axis=-1
             )
         m, g = self.mass, self.gravity
         acc = np.stack((fx / m + g[..., 0], fy / m + g[..., 1], fz / m + g[..., 2]), axis=-1)
@@ -248,18 +271,21 @@ class BatchTask:
     ) -> None:
         """The world's substeps with the rows' drives and props' moves, then one read of the
         rows' bodies (the calls of ``Simulator.step_bodies`` and ``body_states``, by ``map``)."""
-        pb, c = pybullet, self.client
+        pb = pybullet
         every = len(rows) == self.n
         if every:
             if not self._uids:
                 self._uids = self.uid.ravel().tolist()
-            uids = self._uids
+            uids, clients = self._uids, self._clients
+            worlds = self._worlds
         else:
             uids = self.uid[sel].ravel().tolist()
+            clients = np.repeat(self.client[sel], self.b).tolist()
+            worlds = sorted(set(self.client[sel].tolist()))
         count = len(uids)
         if not count:
             return
-        minus, world, clients = [-1] * count, [pb.WORLD_FRAME] * count, [c] * count
+        minus, world = [-1] * count, [pb.WORLD_FRAME] * count
         f = forces[sel].reshape(-1, 3).tolist()
         tq = None if torques is None else torques[sel].reshape(-1, 3).tolist()
         p = paths[:, sel].reshape(len(paths), -1, 3).tolist()
@@ -267,36 +293,38 @@ class BatchTask:
         force, torque, step = pb.applyExternalForce, pb.applyExternalTorque, pb.stepSimulation
         for k, pk in enumerate(p):
             if moves:
-                props, spots = moves[k]
-                m = len(props)
+                props, spots, homes = moves[k]
                 for _ in map(pb.resetBasePositionAndOrientation, props, spots,
-                             [(0.0, 0.0, 0.0, 1.0)] * m, [c] * m):  # fmt: skip
+                             [(0.0, 0.0, 0.0, 1.0)] * len(props), homes):  # fmt: skip
                     pass
             for _ in map(force, uids, minus, f, pk, world, clients):
                 pass
             if tq is not None:
                 for _ in map(torque, uids, minus, tq, world, clients):
                     pass
-            step(c)
+            for c in worlds:
+                step(c)
         poses = map(pb.getBasePositionAndOrientation, uids, clients)
         speeds = map(pb.getBaseVelocity, uids, clients)
         read = [p + o + v + w for (p, o), (v, w) in zip(poses, speeds, strict=True)]
         self.state[sel] = np.array(read).reshape(-1, self.b, 13)
 
-    def _moves(self, rows: list[int]) -> list[tuple[list[int], list[Any]]]:
-        """Per substep, the props of the stepping sub-envs and their next positions."""
+    def _moves(self, rows: list[int]) -> list[tuple[list[int], list[Any], list[int]]]:
+        """Per substep, the props of the stepping sub-envs, their next positions and worlds."""
         stepping = self.props if len(rows) == self.n else sorted(set(self.props) & set(rows))
         if not stepping:
             return []
-        out: list[tuple[list[int], list[Any]]] = []
+        out: list[tuple[list[int], list[Any], list[int]]] = []
         for k in range(len(self.coef)):
             uids: list[int] = []
             spots: list[Any] = []
+            homes: list[int] = []
             for i in stepping:
                 env = self.envs[i]
                 uids += env._prop_uids
                 spots += env._props.at(int(self.tick[i]) * len(self.coef) + k + 1)
-            out.append((uids, spots))
+                homes += [env.sim.client] * len(env._prop_uids)
+            out.append((uids, spots, homes))
         return out
 
     def measure(self, sel: Any) -> None:
@@ -308,8 +336,8 @@ class BatchTask:
         off = self.offset[sel]
         has_off = self.has_offset[sel]
         ox, oy, oz = off[..., 0], off[..., 1], off[..., 2]
-        rx, ry, rz = (np.where(has_off, r, o) for r, o in
-                      zip(bm.rotate(x, y, z, w, ox, oy, oz), (ox, oy, oz), strict=True))  # fmt: skip
+        turned = rotate((x, y, z, w), (ox, oy, oz))
+        rx, ry, rz = (np.where(has_off, r, o) for r, o in zip(turned, (ox, oy, oz), strict=True))
         pos = s[..., 0:3]
         lever = np.stack((rx, ry, rz), axis=-1)
         point = np.where(has_off[..., None], pos + lever, pos)
@@ -325,7 +353,8 @@ class BatchTask:
         self.ptl[sel] = np.where(has_pos, self.ptime[sel] - t, 0.0)
         self.point[sel] = point
         has_ori = self.has_ori[sel]
-        qx, qy, qz, qw = bm.mul_conjugate(s[..., 3:7], self.goal_q[sel])
+        g = self.goal_q[sel]
+        qx, qy, qz, qw = mul_conjugate((x, y, z, w), (g[..., 0], g[..., 1], g[..., 2], g[..., 3]))
         vx, vy, vz = bm.log(qx, qy, qz, qw)
         phi = self.phi[sel]
         ux, uy, uz = bm.unwrap_rotvec(vx, vy, vz, phi[..., 0], phi[..., 1], phi[..., 2])
@@ -334,7 +363,8 @@ class BatchTask:
 
     def _advance(self, rows: list[int]) -> dict[int, list[GoalEvent]]:
         """``GoalTask.advance`` of the sub-envs on a goal tick (scalar: goal ticks are rare);
-        a sub-env whose goal changed is measured again, as ``SGCEnv._observe(read=False)``."""
+        a sub-env whose goal changed is measured again, as ``SGCEnv._observe(read=False)``,
+        by its own ``GoalTask.measure`` (a numpy pass over a few rows costs more)."""
         due = (self.tick >= self.next_event) & (self.next_event >= 0)
         if not due.any():
             return {}
@@ -351,12 +381,15 @@ class BatchTask:
                 events[i] = happened
             if moved:
                 self.load_goals(i)
-                self.phi[i] = [tuple(p) for p in task.phi]
                 changed.append(i)
             else:
                 self.next_event[i] = task.next_event
-        if changed:
-            self.measure(np.asarray(changed, dtype=np.intp))
+        for i in changed:
+            task = self.envs[i].task
+            task.measure(readings(self.state[i].tolist()), int(self.tick[i]) * self.envs[i].dt)
+            self.point[i], self.dev[i] = task.points, task.deviations
+            self.phi[i] = [tuple(p) for p in task.phi]
+            self.ptl[i], self.otl[i] = task.position_time_left, task.orientation_time_left
         return events
 
     def _flags(self, sel: Any) -> None:
@@ -398,9 +431,7 @@ class BatchTask:
             return bm.norm3(d[:, 0], d[:, 1], d[:, 2]) / scale
         ahead = left >= 0.0
         f = left / c[:, 3]
-        ex, ey, ez = (
-            d[:, k] - np.where(ahead, c[:, k] * f, -c[:, 8 + k] * left) for k in range(3)
-        )
+        ex, ey, ez = (d[:, k] - np.where(ahead, c[:, k] * f, -c[:, 8 + k] * left) for k in range(3))
         return bm.at_most(bm.norm3(ex, ey, ez) / scale, TRACK_COST_CAP)
 
     def _effort(self, actions: np.ndarray) -> np.ndarray:
@@ -417,13 +448,7 @@ class BatchTask:
     def _bonus(self, events: dict[int, list[GoalEvent]]) -> np.ndarray:
         bonus = np.zeros(self.n)
         for i, happened in events.items():
-            total = 0.0
-            for ev in happened:
-                if ev["position_error"] is not None:
-                    total += math.exp(-ev["position_error"] / BONUS_POSITION)
-                if ev["orientation_error"] is not None:
-                    total += math.exp(-ev["orientation_error"] / BONUS_ORIENTATION)
-            bonus[i] = total
+            bonus[i] = goal_bonus(happened)
         return bonus
 
     def _record(self) -> None:
