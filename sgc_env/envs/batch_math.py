@@ -36,9 +36,13 @@ def norm3(x: Arr, y: Arr, z: Arr) -> Arr:
 def log(x: Arr, y: Arr, z: Arr, w: Arr) -> tuple[Arr, Arr, Arr]:
     """:func:`sgc_env.paper.quaternion.log` per element."""
     flip = w < 0.0
-    x, y, z, w = (np.where(flip, -c, c) for c in (x, y, z, w))
+    if flip.any():
+        x, y, z, w = (np.where(flip, -c, c) for c in (x, y, z, w))
     vnorm = norm3(x, y, z)
-    scale = np.where(vnorm < 1e-12, 2.0 / w, 2.0 * atan2(vnorm, w) / vnorm)
+    scale = 2.0 * atan2(vnorm, w) / vnorm
+    small = vnorm < 1e-12
+    if small.any():
+        scale = np.where(small, 2.0 / w, scale)
     return x * scale, y * scale, z * scale
 
 
@@ -47,14 +51,20 @@ def unwrap_rotvec(px: Arr, py: Arr, pz: Arr, rx: Arr, ry: Arr, rz: Arr) -> tuple
     as ``np.rint``)."""
     angle = norm3(px, py, pz)
     tiny = angle < 1e-12
-    rn = norm3(rx, ry, rz)
-    keep = tiny & (rn < math.pi)
-    ux = np.where(tiny, rx / rn, px / angle)
-    uy = np.where(tiny, ry / rn, py / angle)
-    uz = np.where(tiny, rz / rn, pz / angle)
+    if tiny.any():
+        rn = norm3(rx, ry, rz)
+        keep = tiny & (rn < math.pi)
+        ux = np.where(tiny, rx / rn, px / angle)
+        uy = np.where(tiny, ry / rn, py / angle)
+        uz = np.where(tiny, rz / rn, pz / angle)
+    else:
+        keep = tiny
+        ux, uy, uz = px / angle, py / angle, pz / angle
     s = ux * rx + uy * ry + uz * rz
     k = np.rint((s - angle) / TWO_PI)
     keep |= k == 0
+    if keep.all():
+        return px, py, pz
     a = angle + TWO_PI * k
     return np.where(keep, px, ux * a), np.where(keep, py, uy * a), np.where(keep, pz, uz * a)
 

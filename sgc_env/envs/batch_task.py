@@ -239,26 +239,28 @@ class BatchTask:
         """``Actuation.drives`` of every sub-env: forces, torques (or None), CoM paths
         (substeps, N, bodies, 3) and the applied record (N, 6 * bodies)."""
         n, b = self.n, self.b
-        per = 6 if self.use_torque else 3
-        a = actions.reshape(n, b, per)
-        fl = self.flimit
-        fx, fy, fz = a[..., 0] * fl, a[..., 1] * fl, a[..., 2] * fl
-        forces = np.stack((fx, fy, fz), axis=-1)
+        a = actions.reshape(n, b, 6 if self.use_torque else 3)
+        forces = a[..., 0:3] * self.flimit[..., None]
         s = self.state
+        applied = np.empty((n, 6 * b))
+        applied[:, : 3 * b] = forces.reshape(n, -1)
         torques = None
         if self.use_torque:
             x, y, z, w = s[..., 3], s[..., 4], s[..., 5], s[..., 6]
             bx, by, bz = rotate((-x, -y, -z, w), (a[..., 3], a[..., 4], a[..., 5]))
             sc = self.tscale
-            torques = np.stack(
-                rotate((x, y, z, w), (bx * sc[..., 0], by * sc[..., 1], bz * sc[..., 2])), axis=-1
+            torques = np.empty((n, b, 3))
+            torques[..., 0], torques[..., 1], torques[..., 2] = rotate(
+                (x, y, z, w), (bx * sc[..., 0], by * sc[..., 1], bz * sc[..., 2])
             )
-        m, g = self.mass, self.gravity
-        acc = np.stack((fx / m + g[..., 0], fy / m + g[..., 1], fz / m + g[..., 2]), axis=-1)
+            applied[:, 3 * b :] = torques.reshape(n, -1)
+        else:
+            applied[:, 3 * b :] = 0.0
+        acc = forces / self.mass[..., None] + self.gravity
         x0, v = s[..., 0:3], s[..., 7:10]
-        paths = np.stack([x0 + kh * v + c * acc for kh, c in self.coef])
-        second = torques if torques is not None else np.zeros_like(forces)
-        applied = np.concatenate((forces.reshape(n, -1), second.reshape(n, -1)), axis=1)
+        paths = np.empty((len(self.coef), n, b, 3))
+        for k, (kh, c) in enumerate(self.coef):
+            np.add(x0 + kh * v, c * acc, out=paths[k])
         return forces, torques, paths, applied
 
     def _physics(
@@ -329,37 +331,54 @@ class BatchTask:
 
     def measure(self, sel: Any) -> None:
         """``GoalTask.measure`` of the rows ``sel``: tracked points, D and D', unwrapped phi,
-        times left (see GoalTask)."""
+        times left (see GoalTask). A branch all rows take skips the ``np.where``."""
         s = self.state[sel]
         t = (self.tick[sel] * self.dt[sel])[:, None]
         x, y, z, w = s[..., 3], s[..., 4], s[..., 5], s[..., 6]
-        off = self.offset[sel]
-        has_off = self.has_offset[sel]
-        ox, oy, oz = off[..., 0], off[..., 1], off[..., 2]
-        turned = rotate((x, y, z, w), (ox, oy, oz))
-        rx, ry, rz = (np.where(has_off, r, o) for r, o in zip(turned, (ox, oy, oz), strict=True))
         pos = s[..., 0:3]
-        lever = np.stack((rx, ry, rz), axis=-1)
-        point = np.where(has_off[..., None], pos + lever, pos)
-        nail = self.nail[sel]
-        has_pos = self.has_pos[sel]
+        lever = self.offset[sel]
+        has_off = self.has_offset[sel]
+        point = pos
+        if has_off.any():
+            turned = np.empty_like(lever)
+            turned[..., 0], turned[..., 1], turned[..., 2] = rotate(
+                (x, y, z, w), (lever[..., 0], lever[..., 1], lever[..., 2])
+            )
+            point = pos + turned
+            if not has_off.all():
+                turned = np.where(has_off[..., None], turned, lever)
+                point = np.where(has_off[..., None], point, pos)
+            lever = turned
+        rx, ry, rz = lever[..., 0], lever[..., 1], lever[..., 2]
         wx, wy, wz = s[..., 10], s[..., 11], s[..., 12]
-        dev = np.stack((
-            point[..., 0] - nail[..., 0], point[..., 1] - nail[..., 1],
-            point[..., 2] - nail[..., 2], s[..., 7] + wy * rz - wz * ry,
-            s[..., 8] + wz * rx - wx * rz, s[..., 9] + wx * ry - wy * rx,
-        ), axis=-1)  # fmt: skip
-        self.dev[sel] = np.where(has_pos[..., None], dev, 0.0)
-        self.ptl[sel] = np.where(has_pos, self.ptime[sel] - t, 0.0)
-        self.point[sel] = point
+        dev = np.empty(s.shape[:-1] + (6,))
+        dev[..., 0:3] = point - self.nail[sel]
+        dev[..., 3] = s[..., 7] + wy * rz - wz * ry
+        dev[..., 4] = s[..., 8] + wz * rx - wx * rz
+        dev[..., 5] = s[..., 9] + wx * ry - wy * rx
+        has_pos = self.has_pos[sel]
+        left = self.ptime[sel] - t
+        if not has_pos.all():
+            dev = np.where(has_pos[..., None], dev, 0.0)
+            left = np.where(has_pos, left, 0.0)
+        self.dev[sel], self.ptl[sel], self.point[sel] = dev, left, point
         has_ori = self.has_ori[sel]
+        if not has_ori.any():
+            self.otl[sel] = 0.0
+            return
         g = self.goal_q[sel]
         qx, qy, qz, qw = mul_conjugate((x, y, z, w), (g[..., 0], g[..., 1], g[..., 2], g[..., 3]))
         vx, vy, vz = bm.log(qx, qy, qz, qw)
         phi = self.phi[sel]
-        ux, uy, uz = bm.unwrap_rotvec(vx, vy, vz, phi[..., 0], phi[..., 1], phi[..., 2])
-        self.phi[sel] = np.where(has_ori[..., None], np.stack((ux, uy, uz), axis=-1), phi)
-        self.otl[sel] = np.where(has_ori, self.otime[sel] - t, 0.0)
+        new = np.empty_like(phi)
+        new[..., 0], new[..., 1], new[..., 2] = bm.unwrap_rotvec(
+            vx, vy, vz, phi[..., 0], phi[..., 1], phi[..., 2]
+        )
+        left = self.otime[sel] - t
+        if not has_ori.all():
+            new = np.where(has_ori[..., None], new, phi)
+            left = np.where(has_ori, left, 0.0)
+        self.phi[sel], self.otl[sel] = new, left
 
     def _advance(self, rows: list[int]) -> dict[int, list[GoalEvent]]:
         """``GoalTask.advance`` of the sub-envs on a goal tick (scalar: goal ticks are rare);
@@ -406,20 +425,26 @@ class BatchTask:
     def _rewards(self, actions: np.ndarray, events: dict[int, list[GoalEvent]]) -> np.ndarray:
         """The reward mode of every sub-env (``rewards._ModeReward``), with its failure charge."""
         n, b = self.n, self.b
-        cost = np.zeros(n)
-        worst = np.zeros(n)
+        cost: Any = 0.0
+        worst: Any = 0.0
         if self.mode != "sparse":
             tracks = (
                 (self.has_pos, self.dev, self.ptl, self.pcourse, POSITION_FLOOR),
                 (self.has_ori, self.phi, self.otl, self.ocourse, ORIENTATION_FLOOR),
             )
             for j in range(b):  # tracks in tracks_of's order: body by body, position first
-                for has, d, left, course, floor in tracks:
+                for has_track, d, left, course, floor in tracks:
+                    has = has_track[:, j]
+                    if not has.any():
+                        continue
                     value = self._cost(d[:, j], left[:, j], course[:, j], floor)
-                    cost = np.where(has[:, j], cost + value, cost)
-                    worst = np.where(has[:, j], worst + TRACK_COST_CAP, worst)
-        reward = -cost / b - self._effort(actions) + self._bonus(events)
-        if self.mode != "distance":
+                    if has.all():
+                        cost, worst = cost + value, worst + TRACK_COST_CAP
+                    else:
+                        cost = np.where(has, cost + value, cost)
+                        worst = np.where(has, worst + TRACK_COST_CAP, worst)
+        reward = -np.broadcast_to(cost, (n,)) / b - self._effort(actions) + self._bonus(events)
+        if self.mode != "distance" and self.failed.any():
             charge = (worst / b + EFFORT_WEIGHT) * (self.max_steps - self.tick)
             reward = np.where(self.failed, reward - charge, reward)
         return reward
@@ -430,9 +455,15 @@ class BatchTask:
         if self.mode == "distance":
             return bm.norm3(d[:, 0], d[:, 1], d[:, 2]) / scale
         ahead = left >= 0.0
-        f = left / c[:, 3]
-        ex, ey, ez = (d[:, k] - np.where(ahead, c[:, k] * f, -c[:, 8 + k] * left) for k in range(3))
-        return bm.at_most(bm.norm3(ex, ey, ez) / scale, TRACK_COST_CAP)
+        if ahead.all():
+            f = left / c[:, 3]
+            e = [d[:, k] - c[:, k] * f for k in range(3)]
+        elif not ahead.any():
+            e = [d[:, k] - -c[:, 8 + k] * left for k in range(3)]
+        else:
+            f = left / c[:, 3]
+            e = [d[:, k] - np.where(ahead, c[:, k] * f, -c[:, 8 + k] * left) for k in range(3)]
+        return bm.at_most(bm.norm3(e[0], e[1], e[2]) / scale, TRACK_COST_CAP)
 
     def _effort(self, actions: np.ndarray) -> np.ndarray:
         """``EFFORT_WEIGHT * sum(x * x) / len``, summed left to right as Python's ``sum``."""
