@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from sgc_env.envs import batch_math as bm
-from sgc_env.envs.batch_task import BatchTask, mul_conjugate, rotate
+from sgc_env.envs.batch_task import BatchTask
 from sgc_env.envs.rewards import _effort, distance_cost, schedule_cost
 from sgc_env.paper import quaternion
 
@@ -32,12 +32,14 @@ def test_quaternion_helpers_on_arrays_equal_the_scalar_ones() -> None:
     rng = np.random.default_rng(0)
     a, b = _quaternions(rng, 64), _quaternions(rng, 64)[::-1]
     v = rng.normal(size=(64, 3))
+    back = a * np.array([-1.0, -1.0, -1.0, 1.0])
     with np.errstate(all="ignore"):
-        _same(np.stack(rotate(tuple(a.T), tuple(v.T)), 1),
-              [quaternion.rotate(p, u) for p, u in zip(a, v, strict=True)])  # fmt: skip
-        _same(np.stack(mul_conjugate(tuple(a.T), tuple(b.T)), 1),
+        _same(bm.rotate(a, v), [quaternion.rotate(p, u) for p, u in zip(a, v, strict=True)])
+        _same(bm.rotate(back, v), [quaternion.rotate_back(p, u) for p, u in zip(a, v, strict=True)])
+        _same(bm.mul_conjugate(a, bm.conjugate_factors(b)),
               [quaternion.mul_conjugate(p, q) for p, q in zip(a, b, strict=True)])  # fmt: skip
-        _same(np.stack(bm.log(*a.T), 1), [quaternion.log(p) for p in a])
+        _same(bm.log(a), [quaternion.log(p) for p in a])
+        _same(bm.norm(v), [float(np.sqrt(x * x + y * y + z * z)) for x, y, z in v.tolist()])
 
 
 @pytest.mark.parametrize("scale", [0.0, 1e-13, 0.3, 3.0, 40.0])
@@ -50,9 +52,9 @@ def test_unwrap_equals_the_scalar_one(scale: float) -> None:
     reference[:4] = rng.normal(0, 5.0, (4, 3))  # |reference| >= pi with a tiny principal
     reference[60:] = -7.0 * principal[60:]  # a somersault the other way
     with np.errstate(all="ignore"):
-        out = bm.unwrap_rotvec(*principal.T, *reference.T)
+        out = bm.unwrap_rotvec(principal, reference)
     scalar = [quaternion.unwrap_rotvec(p, r) for p, r in zip(principal, reference, strict=True)]
-    _same(np.stack(out, 1), scalar)
+    _same(out, scalar)
 
 
 @pytest.mark.parametrize("mode", ["schedule", "distance"])

@@ -70,9 +70,10 @@ assert (_OFF, _DEV, _PV, _PTL, _PC, _PHI, _OTL, _OC, _RES, _ORES, BODY_BLOCK_SIZ
     77,
 ), "the observation layout changed: update BatchTask's record"
 
-# The scalar quaternion helpers, applied to tuples of arrays (their arithmetic is elementwise).
+_YZX, _ZXY = [1, 2, 0], [2, 0, 1]
+# The scalar quaternion rotation, applied to tuples of arrays (its arithmetic is elementwise):
+# on the few-element arrays of a step, per-component operations beat gathers.
 rotate: Callable[..., Any] = quaternion.rotate
-mul_conjugate: Callable[..., Any] = quaternion.mul_conjugate
 
 
 def readings(rows: list[list[float]]) -> list[BodyReading]:
@@ -113,6 +114,7 @@ class BatchTask:
         self.has_offset = z((n, b), dtype=bool)
         self.offset, self.offset_res, self.nail = z((n, b, 3)), z((n, b, 3)), z((n, b, 3))
         self.goal_q = z((n, b, 4))
+        self.goal_factors = z((4, n, b, 4))  # bm.conjugate_factors of goal_q
         self.ptime, self.otime = z((n, b)), z((n, b))
         self.pcourse, self.ocourse = z((n, b, 13)), z((n, b, 13))
         self.goal_index = np.full((n, b), -1)
@@ -176,6 +178,7 @@ class BatchTask:
         self.offset_res[i] = task.offset_residuals
         self.nail[i] = task.nails
         self.goal_q[i] = task.goal_quaternions
+        self.goal_factors[:, i] = bm.conjugate_factors(self.goal_q[i])
         self.ptime[i], self.otime[i] = task.position_goal_time, task.orientation_goal_time
         self.pcourse[i], self.ocourse[i] = task.position_course, task.orientation_course
         self.goal_index[i] = task.goal_index
@@ -334,28 +337,22 @@ class BatchTask:
         times left (see GoalTask). A branch all rows take skips the ``np.where``."""
         s = self.state[sel]
         t = (self.tick[sel] * self.dt[sel])[:, None]
-        x, y, z, w = s[..., 3], s[..., 4], s[..., 5], s[..., 6]
-        pos = s[..., 0:3]
+        pos, q, ang = s[..., 0:3], s[..., 3:7], s[..., 10:13]
         lever = self.offset[sel]
         has_off = self.has_offset[sel]
         point = pos
         if has_off.any():
-            turned = np.empty_like(lever)
-            turned[..., 0], turned[..., 1], turned[..., 2] = rotate(
-                (x, y, z, w), (lever[..., 0], lever[..., 1], lever[..., 2])
-            )
+            turned = bm.rotate(q, lever)
             point = pos + turned
             if not has_off.all():
                 turned = np.where(has_off[..., None], turned, lever)
                 point = np.where(has_off[..., None], point, pos)
             lever = turned
-        rx, ry, rz = lever[..., 0], lever[..., 1], lever[..., 2]
-        wx, wy, wz = s[..., 10], s[..., 11], s[..., 12]
         dev = np.empty(s.shape[:-1] + (6,))
         dev[..., 0:3] = point - self.nail[sel]
-        dev[..., 3] = s[..., 7] + wy * rz - wz * ry
-        dev[..., 4] = s[..., 8] + wz * rx - wx * rz
-        dev[..., 5] = s[..., 9] + wx * ry - wy * rx
+        # D' = v + omega x r, each component as GoalTask.measure sums it
+        dev[..., 3:6] = s[..., 7:10] + ang[..., _YZX] * lever[..., _ZXY]
+        dev[..., 3:6] -= ang[..., _ZXY] * lever[..., _YZX]
         has_pos = self.has_pos[sel]
         left = self.ptime[sel] - t
         if not has_pos.all():
@@ -366,14 +363,9 @@ class BatchTask:
         if not has_ori.any():
             self.otl[sel] = 0.0
             return
-        g = self.goal_q[sel]
-        qx, qy, qz, qw = mul_conjugate((x, y, z, w), (g[..., 0], g[..., 1], g[..., 2], g[..., 3]))
-        vx, vy, vz = bm.log(qx, qy, qz, qw)
+        factors = [f[sel] for f in self.goal_factors]
         phi = self.phi[sel]
-        new = np.empty_like(phi)
-        new[..., 0], new[..., 1], new[..., 2] = bm.unwrap_rotvec(
-            vx, vy, vz, phi[..., 0], phi[..., 1], phi[..., 2]
-        )
+        new = bm.unwrap_rotvec(bm.log(bm.mul_conjugate(q, factors)), phi)
         left = self.otime[sel] - t
         if not has_ori.all():
             new = np.where(has_ori[..., None], new, phi)
