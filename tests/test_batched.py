@@ -197,7 +197,8 @@ def test_sharded_worlds_equal_single_envs(env_id: str, monkeypatch: pytest.Monke
 
 
 def test_scenes_per_world() -> None:
-    assert batch_module.scenes_per_world(64, 1) == 16  # 16 objects per world
-    assert batch_module.scenes_per_world(8, 7) == 2
-    assert batch_module.scenes_per_world(256, 7) == 8  # at most MAX_WORLDS (32) worlds
+    assert batch_module.scenes_per_world(64, 1) == 8  # 8 objects per world
+    assert batch_module.scenes_per_world(8, 7) == 1
+    assert batch_module.scenes_per_world(8, 3) == 2
+    assert batch_module.scenes_per_world(256, 7) == 11  # at most MAX_WORLDS (24) worlds
     assert batch_module.scenes_per_world(4, 40) == 1

@@ -36,22 +36,24 @@ __all__ = ["MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
            "scenes_per_world"]  # fmt: skip
 
 MAX_ENVS = 1024
-"""Most sub-envs per world. Why a cap: memory stays near 1 GB for three-rod scenes (~1 MB each),
-larger worlds were never measured, and the per-step cost only grows with N (in
-scripts/bench_vec.py runs 256 rods were already slower per env-step than 64)."""
+"""Most sub-envs per batch. Why a cap: with at most :data:`MAX_WORLDS` worlds, more scenes
+crowd each world and its quadratic step cost (see :data:`SHARD_OBJECTS`) grows again; batches
+beyond it were never measured."""
 
 StepResult = tuple[Any, float, bool, bool, Any]
 
 
-SHARD_OBJECTS = 16
+SHARD_OBJECTS = 8
 """Objects (bodies and props) per PyBullet world, about. Why shards: PyBullet's
-``stepSimulation`` costs O(objects^2) in one world even without collision shapes (measured:
-3 us per body-step at 16 bodies, 16 at 64, 58 at 256), so the batch spreads its scenes over
-several worlds (clients) of about this many objects."""
+``stepSimulation`` costs O(objects^2) in one world even without collision shapes (measured,
+free bodies: 3 us per body-step at 16 bodies, 16 at 64, 58 at 256), so the batch spreads its
+scenes over several worlds (clients); 4 to 16 objects per world cost about the same per body
+(scripts/bench_vec.py), fewer pay the per-call overhead of stepping a world."""
 
-MAX_WORLDS = 32
+MAX_WORLDS = 24
 """Most worlds per batch: each PyBullet client holds ~28 MB, so more scenes share a world
-once N scenes would need more (a 256-scene three-rod batch: 8 scenes of 7 objects per world)."""
+once N scenes would need more (a 256-scene three-rod batch: 11 scenes of 7 objects per world,
+~1.25 GB resident with SB3 imported; 32 worlds took it to 1.48 GB)."""
 
 
 def scenes_per_world(num_envs: int, objects: int) -> int:
