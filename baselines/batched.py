@@ -104,10 +104,9 @@ class BatchedVecEnv(VecEnv):
         fast = batch.fast
         assert fast is not None
         rewards, terminated, truncated, events = batch.step_fast(indices, self._actions)
-        infos = row_infos(fast, events)
+        cut = (truncated & ~terminated).tolist()
+        infos = row_infos(fast, events, "TimeLimit.truncated", cut)
         dones = terminated | truncated
-        for info, cut in zip(infos, (truncated & ~terminated).tolist(), strict=True):
-            info["TimeLimit.truncated"] = cut
         obs, _ = fast.share()  # the resets below write into copies
         for i in np.flatnonzero(dones).tolist():
             infos[i]["terminal_observation"] = obs[i]

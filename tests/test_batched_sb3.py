@@ -37,6 +37,10 @@ def test_adapter_steps_as_dummy_vec_env(env_id: str) -> None:
             od, rd, dd, idd = dummy.step(actions)
             assert _equal(ob, od) and np.array_equal(rb, rd) and np.array_equal(db, dd)
             for b, d in zip(ib, idd, strict=True):
+                assert b.keys() == d.keys()  # the batched env's infos are filled when read
+                for key in d.keys() - {"episode", "terminal_observation", "goal_reached"}:
+                    assert np.array_equal(b[key], d[key]), key
+                assert b.get("goal_reached") == d.get("goal_reached")
                 assert b["TimeLimit.truncated"] == d["TimeLimit.truncated"]
                 assert ("terminal_observation" in b) == ("terminal_observation" in d)
                 if "terminal_observation" in d:

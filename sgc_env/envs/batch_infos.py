@@ -81,13 +81,18 @@ def vector_infos(task: BatchTask, events: dict[int, list[GoalEvent]]) -> dict[st
     return out
 
 
-def row_infos(task: BatchTask, events: dict[int, list[GoalEvent]]) -> list[dict[str, Any]]:
+def row_infos(
+    task: BatchTask, events: dict[int, list[GoalEvent]], key: str, values: list[Any]
+) -> list[dict[str, Any]]:
     """One info dict per sub-env (SB3's layout), each value a row of the step's arrays, made
-    when the dict is first read (:class:`RowInfo`)."""
+    when the dict is first read (:class:`RowInfo`); ``key`` holds ``values[i]`` in dict i
+    (the caller's own entry, e.g. SB3's ``TimeLimit.truncated``)."""
     columns = _columns(task)
     columns["time"] = task.rec[:, task.size - 1]
     columns["spin_clamped"] = task.spin.copy()
-    infos: list[dict[str, Any]] = [RowInfo(columns, i) for i in range(task.n)]
+    infos: list[dict[str, Any]] = [
+        RowInfo(columns, i, key, value) for i, value in enumerate(values)
+    ]
     for i, happened in events.items():
         infos[i]["goal_reached"] = happened
     return infos
@@ -117,8 +122,8 @@ class RowInfo(dict[str, Any]):
 
     __slots__ = ("_row",)
 
-    def __init__(self, columns: dict[str, np.ndarray], row: int) -> None:
-        super().__init__()
+    def __init__(self, columns: dict[str, np.ndarray], row: int, key: str, value: Any) -> None:
+        super().__init__(((key, value),))
         self._row: tuple[dict[str, np.ndarray], int] | None = (columns, row)
 
     def fill(self) -> None:

@@ -379,11 +379,13 @@ class BatchTask:
         due = (self.tick >= self.next_event) & (self.next_event >= 0)
         if not due.any():
             return {}
-        stepping = np.zeros(self.n, dtype=bool)
-        stepping[rows] = True
+        if len(rows) < self.n:
+            stepping = np.zeros(self.n, dtype=bool)
+            stepping[rows] = True
+            due &= stepping
         events: dict[int, list[GoalEvent]] = {}
         changed = []
-        for i in np.flatnonzero(due & stepping).tolist():
+        for i in np.flatnonzero(due).tolist():
             task = self.envs[i].task
             task.deviations = list(map(tuple, self.dev[i].tolist()))
             task.phi = list(map(tuple, self.phi[i].tolist()))
