@@ -116,9 +116,7 @@ def tracks_of(task: GoalTask) -> list[tuple[TrackState, float]]:
     for i in range(task.n_bodies):
         if task.has_position[i]:
             track: TrackState = (
-                task.deviations[i],
-                task.position_time_left[i],
-                task.position_course[i],
+                task.deviations[i], task.position_time_left[i], task.position_course[i]
             )
             out.append((track, POSITION_FLOOR))
         if task.has_orientation[i]:
