@@ -1,4 +1,4 @@
-"""SB3 ``VecEnv`` over the batched env: N sub-envs in one PyBullet world, SB3's conventions.
+"""SB3 ``VecEnv`` over the batched env: N sub-envs in shared PyBullet worlds, SB3's conventions.
 
 The sub-envs are the batched env's (:mod:`sgc_env.envs.batch`), so each steps exactly as
 ``gym.make(id)`` inside ``DummyVecEnv`` would; what changes is SB3's side of the contract:
@@ -32,7 +32,7 @@ VEC_KINDS = ("batched", "dummy", "subproc")
 
 
 class BatchedVecEnv(VecEnv):
-    """``n_envs`` sub-envs of ``env_id`` in one world (see the module docstring)."""
+    """``n_envs`` sub-envs of ``env_id`` in shared worlds (see the module docstring)."""
 
     def __init__(
         self,
@@ -156,7 +156,7 @@ def make_sgc_vec(
     env_kwargs: dict[str, Any] | None = None,
     vec: str | None = None,
 ) -> VecEnv:
-    """A monitored SB3 VecEnv of ``n_envs`` copies of ``env_id``: ``batched`` (one world; the
+    """A monitored SB3 VecEnv of ``n_envs`` copies of ``env_id``: ``batched`` (shared worlds; the
     default where the id has it), ``dummy`` or ``subproc`` (single envs, as
     ``make_vec_env``); sub-env i seeded ``seed + i``."""
     if vec is None:

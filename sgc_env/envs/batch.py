@@ -1,12 +1,11 @@
-"""N sub-envs in one PyBullet world, stepped together: the core of both vector env APIs.
+"""N sub-envs in shared PyBullet worlds, stepped together: the core of both vector env APIs.
 
 Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) built on a
-:class:`~sgc_env.envs.world.WorldView` of one :class:`~sgc_env.envs.world.SharedWorld`, so its
-task logic, observation, reward and goal events are the single env's own code: a sub-env is a
-single env whose physics step is shared. A control step gathers every stepping sub-env's
-drives, runs the world's substeps once, then lets each sub-env observe. The Gymnasium
-(:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters differ only in their reset
-conventions and in how they batch what this returns.
+:class:`~sgc_env.envs.world.WorldView` of a :class:`~sgc_env.envs.world.SharedWorld`; the
+scenes are spread over worlds of about :data:`SHARD_OBJECTS` objects (why: there). A control
+step gathers every stepping sub-env's drives, runs each world's substeps once, then observes
+every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters
+differ only in their reset conventions and in how they batch what this returns.
 
 A sub-env that does not step in a call (it is being reset) still has bodies in the world that
 the substeps integrate; its reset comes after the physics and overwrites their state, so it
@@ -74,7 +73,7 @@ def check_num_envs(num_envs: object) -> int:
 
 
 class Batch:
-    """The sub-envs of one world (see the module docstring)."""
+    """The sub-envs of one batch and their worlds (see the module docstring)."""
 
     def __init__(
         self,

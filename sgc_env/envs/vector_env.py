@@ -1,7 +1,7 @@
 """The batched env as a Gymnasium 1.x ``VectorEnv``: every registered id's vector entry point.
 
 ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` builds N sub-envs
-in one PyBullet client (:mod:`.batch`); each sub-env's observations, rewards, flags and goal
+in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags and goal
 events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
 (tests/test_batched.py). Conventions:
 
@@ -71,7 +71,7 @@ def batch_infos(infos: list[dict[str, Any]], indices: list[int], n: int) -> dict
 
 
 class SGCVectorEnv(VectorEnv):
-    """``num_envs`` SGC envs in one PyBullet world (see the module docstring); the other
+    """``num_envs`` SGC envs in shared PyBullet worlds (see the module docstring); the other
     keyword arguments are the single env's (``gym.make(id, **kwargs)``)."""
 
     env_class: type[SGCEnv] = SGCEnv
