@@ -30,6 +30,12 @@ def _row(batch: Any, i: int) -> Any:
     return {k: v[i] for k, v in batch.items()} if isinstance(batch, dict) else batch[i]
 
 
+@pytest.fixture(autouse=True)
+def _numpy_step_from_one_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Small batches here step by the numpy path, as batches of FAST_MIN_ENVS or more do."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 1)
+
+
 RL_ZOO_PATCH_KEY = "TimeLimit.truncated"
 """Added to a single env's last info by rl_zoo3's patched ``TimeLimit`` once any test imported
 ``rl_zoo3.gym_patches``: a wrapper's key, not the env's, and the vector env has no TimeLimit."""
@@ -202,3 +208,15 @@ def test_scenes_per_world() -> None:
     assert batch_module.scenes_per_world(8, 3) == 2
     assert batch_module.scenes_per_world(256, 7) == 11  # at most MAX_WORLDS (24) worlds
     assert batch_module.scenes_per_world(4, 40) == 1
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_small_batches_step_each_sub_env(env_id: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Below FAST_MIN_ENVS the sub-envs step by their own code (the goal env always does)."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 8)
+    vec = make_vec(env_id, 2)
+    try:
+        assert vec.unwrapped._batch.fast is None
+    finally:
+        vec.close()
+    assert run_pair(env_id, 2, 45, max_episode_steps=20) >= 2

@@ -13,6 +13,13 @@ from stable_baselines3.common.vec_env import VecNormalize
 from baselines import SGCExpert
 from baselines.batched import BatchedVecEnv, make_sgc_vec
 from baselines.vector import base_env
+from sgc_env.envs import batch as batch_module
+
+
+@pytest.fixture(autouse=True)
+def _numpy_step_from_one_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Small batches here step by the numpy path, as batches of FAST_MIN_ENVS or more do."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 1)
 
 
 def _equal(a: object, b: object) -> bool:

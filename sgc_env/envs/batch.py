@@ -11,7 +11,8 @@ A sub-env that does not step in a call (it is being reset) still has bodies in t
 the substeps integrate; its reset comes after the physics and overwrites their state, so it
 starts exactly where a single env's reset would.
 
-Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one) step by the fast path,
+Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one; :data:`FAST_MIN_ENVS` or
+more of them) step by the fast path,
 :meth:`Batch.step_fast`: the task work of all sub-envs at once in numpy
 (:class:`~sgc_env.envs.batch_task.BatchTask`), the sub-env objects brought up to date only
 when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
@@ -31,7 +32,7 @@ from .batch_task import BatchTask, GoalEvent
 from .sgc_env import SGCEnv
 from .world import SharedWorld
 
-__all__ = ["MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
+__all__ = ["FAST_MIN_ENVS", "MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
            "scenes_per_world"]  # fmt: skip
 
 MAX_ENVS = 1024
@@ -53,6 +54,12 @@ MAX_WORLDS = 24
 """Most worlds per batch: each PyBullet client holds ~28 MB, so more scenes share a world
 once N scenes would need more (a 256-scene three-rod batch: 11 scenes of 7 objects per world,
 ~1.25 GB resident with SB3 imported; 32 worlds took it to 1.48 GB)."""
+
+
+FAST_MIN_ENVS = 8
+"""Fewest sub-envs that step by the numpy path (:class:`BatchTask`): its few hundred numpy calls
+per step cost about the same for 1 sub-env as for 64, more than a few sub-envs' own Python
+(scripts/bench_vec.py: at N = 1 it ran at about a third of DummyVecEnv's rate)."""
 
 
 def scenes_per_world(num_envs: int, objects: int) -> int:
@@ -109,7 +116,8 @@ class Batch:
         )
         self.env_id = env_id
         self.elapsed = np.zeros(n, dtype=np.int64)
-        self.fast = BatchTask(self._envs) if env_class is SGCEnv else None
+        fast = env_class is SGCEnv and n >= FAST_MIN_ENVS
+        self.fast = BatchTask(self._envs) if fast else None
         self._behind = False  # the sub-env objects lag the fast path's arrays
         self._handed = False  # the sub-envs were handed out: reload the arrays from them
 

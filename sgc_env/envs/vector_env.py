@@ -1,8 +1,8 @@
 """The batched env as a Gymnasium 1.x ``VectorEnv``: every registered id's vector entry point.
 
 ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` builds N sub-envs
-in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags and goal
-events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
+in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags
+and goal events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
 (tests/test_batched.py). Conventions:
 
 - ``single_observation_space`` / ``single_action_space``; batched spaces from Gymnasium;
