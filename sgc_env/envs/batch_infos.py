@@ -21,15 +21,27 @@ from .task import GoalEvent
 __all__ = ["row_infos", "vector_infos"]
 
 _L = ObservationLayout(1)
-_BLOCK_KEYS = (
-    ("position_deviation", "position_deviation"),
-    ("orientation_deviation", "orientation_deviation"),
-    ("time_to_goal", "position_time_left"),
-    ("orientation_time_to_goal", "orientation_time_left"),
-    ("body_position", "position"),
-    ("body_orientation", "orientation"),
-    ("body_velocity", "linear_velocity"),
-    ("body_angular_velocity", "angular_velocity"),
+
+
+def _block_index(name: str) -> slice | int:
+    """The body-block columns of a field (one column as an int: a (N, bodies) array)."""
+    cols = _L.body_slice(0, name)
+    return cols if cols.stop - cols.start > 1 else cols.start
+
+
+_BLOCK_KEYS = tuple(
+    (key, _block_index(name))
+    for key, name in (
+        ("position_deviation", "position_deviation"),
+        ("orientation_deviation", "orientation_deviation"),
+        ("time_to_goal", "position_time_left"),
+        ("orientation_time_to_goal", "orientation_time_left"),
+        ("body_position", "position"),
+        ("body_orientation", "orientation"),
+        ("body_velocity", "linear_velocity"),
+        ("body_angular_velocity", "angular_velocity"),
+        ("point_velocity", "point_velocity"),
+    )
 )
 _ORDER = (
     "goal_index", "orientation_goal_index", "position_deviation", "orientation_deviation",
@@ -50,13 +62,11 @@ def _columns(task: BatchTask) -> dict[str, np.ndarray]:
         "goal_index": task.goal_index.copy(),
         "orientation_goal_index": task.orientation_goal_index.copy(),
         "point_position": tail[:, 0],
-        "point_velocity": block[..., _L.body_slice(0, "point_velocity")],
         "force": tail[:, 1],
         "torque": tail[:, 2],
     }
-    for key, name in _BLOCK_KEYS:
-        cols = _L.body_slice(0, name)
-        out[key] = block[..., cols] if cols.stop - cols.start > 1 else block[..., cols.start]
+    for key, cols in _BLOCK_KEYS:
+        out[key] = block[..., cols]
     return {key: out[key] for key in _ORDER}
 
 
