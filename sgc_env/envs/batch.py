@@ -45,10 +45,10 @@ StepResult = tuple[Any, float, bool, bool, Any]
 
 SHARD_OBJECTS = 8
 """Objects (bodies and props) per PyBullet world, about. Why shards: PyBullet's
-``stepSimulation`` costs O(objects^2) in one world even without collision shapes (measured,
-free bodies: 3 us per body-step at 16 bodies, 16 at 64, 58 at 256), so the batch spreads its
-scenes over several worlds (clients); 4 to 16 objects per world cost about the same per body
-(scripts/bench_vec.py), fewer pay the per-call overhead of stepping a world."""
+``stepSimulation`` costs O(objects^2) in one world even without collision shapes
+(scripts/bench_world_step.py: about 2 us per body-step in worlds of 4 to 8 bodies, 11 at 64,
+95 at 256), so the batch spreads its scenes over several worlds (clients); a world of one
+body pays the per-call overhead of a step (4 us)."""
 
 MAX_WORLDS = 24
 """Most worlds per batch: each PyBullet client holds ~28 MB, so more scenes share a world
