@@ -1,4 +1,4 @@
-"""SB3 ``VecEnv`` over the batched env: N sub-envs in one PyBullet world, SB3's conventions.
+"""SB3 ``VecEnv`` over the batched env: N sub-envs in shared PyBullet worlds, SB3's conventions.
 
 The sub-envs are the batched env's (:mod:`sgc_env.envs.batch`), so each steps exactly as
 ``gym.make(id)`` inside ``DummyVecEnv`` would; what changes is SB3's side of the contract:
@@ -22,6 +22,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv,
 
 from sgc_env import check_env_id
 from sgc_env.envs.batch import Batch
+from sgc_env.envs.batch_infos import row_infos
 from sgc_env.envs.goal_env import SGCGoalEnv
 from sgc_env.envs.sgc_env import SGCEnv
 
@@ -31,7 +32,7 @@ VEC_KINDS = ("batched", "dummy", "subproc")
 
 
 class BatchedVecEnv(VecEnv):
-    """``n_envs`` sub-envs of ``env_id`` in one world (see the module docstring)."""
+    """``n_envs`` sub-envs of ``env_id`` in shared worlds (see the module docstring)."""
 
     def __init__(
         self,
@@ -49,10 +50,14 @@ class BatchedVecEnv(VecEnv):
         self._batch = Batch(
             n_envs, SGCGoalEnv if goal else SGCEnv, kwargs, max_episode_steps=limit, env_id=env_id
         )
-        self.envs: list[SGCEnv] = self._batch.envs
-        first = self.envs[0]
+        first = self._batch.envs[0]
         super().__init__(n_envs, first.observation_space, first.action_space)
         self._actions: np.ndarray | None = None
+
+    @property
+    def envs(self) -> list[SGCEnv]:
+        """The sub-envs (up to date when read: see ``Batch.envs``)."""
+        return self._batch.envs
 
     def _stack(self, items: list[Any]) -> Any:
         if isinstance(items[0], dict):
@@ -67,7 +72,8 @@ class BatchedVecEnv(VecEnv):
             obs.append(o)
         self._reset_seeds()
         self._reset_options()
-        return self._stack(obs)
+        fast = self._batch.fast
+        return self._stack(obs) if fast is None else fast.share()[0]
 
     def step_async(self, actions: np.ndarray) -> None:
         self._actions = actions
@@ -75,6 +81,8 @@ class BatchedVecEnv(VecEnv):
     def step_wait(self) -> tuple[Any, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         batch, n = self._batch, self.num_envs
         indices = list(range(n))
+        if batch.fast is not None:
+            return self._step_fast(indices)
         values = batch.clip(self._actions, indices)
         obs, infos = [], []
         rewards = np.zeros(n, dtype=np.float32)
@@ -89,6 +97,21 @@ class BatchedVecEnv(VecEnv):
             obs.append(o)
             infos.append(info)
         return self._stack(obs), rewards, dones, infos
+
+    def _step_fast(self, indices: list[int]) -> tuple[Any, np.ndarray, np.ndarray, list[Any]]:
+        """:meth:`step_wait` of plain SGC sub-envs: infos are rows of the step's arrays."""
+        batch = self._batch
+        fast = batch.fast
+        assert fast is not None
+        rewards, terminated, truncated, events = batch.step_fast(indices, self._actions)
+        cut = (truncated & ~terminated).tolist()
+        infos = row_infos(fast, events, "TimeLimit.truncated", cut)
+        dones = terminated | truncated
+        obs, _ = fast.share()  # the resets below write into copies
+        for i in np.flatnonzero(dones).tolist():
+            infos[i]["terminal_observation"] = obs[i]
+            _, self.reset_infos[i] = batch.reset_one(i)
+        return fast.obs, rewards.astype(np.float32), dones, infos
 
     def close(self) -> None:
         self._batch.close()
@@ -133,7 +156,7 @@ def make_sgc_vec(
     env_kwargs: dict[str, Any] | None = None,
     vec: str | None = None,
 ) -> VecEnv:
-    """A monitored SB3 VecEnv of ``n_envs`` copies of ``env_id``: ``batched`` (one world; the
+    """A monitored SB3 VecEnv of ``n_envs`` copies of ``env_id``: ``batched`` (shared worlds; the
     default where the id has it), ``dummy`` or ``subproc`` (single envs, as
     ``make_vec_env``); sub-env i seeded ``seed + i``."""
     if vec is None:

@@ -12,6 +12,7 @@ import pytest
 import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
+from sgc_env.envs import batch as batch_module
 from sgc_env.envs.rewards import REWARD_MODES
 from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
 
@@ -27,6 +28,12 @@ def _same(a: Any, b: Any) -> bool:
 
 def _row(batch: Any, i: int) -> Any:
     return {k: v[i] for k, v in batch.items()} if isinstance(batch, dict) else batch[i]
+
+
+@pytest.fixture(autouse=True)
+def _numpy_step_from_one_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Small batches here step by the numpy path, as batches of FAST_MIN_ENVS or more do."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 1)
 
 
 RL_ZOO_PATCH_KEY = "TimeLimit.truncated"
@@ -180,3 +187,36 @@ def test_gymnasium_conventions() -> None:
             vec.render()
     finally:
         vec.close()
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1", "SGCPointGoal-v0"])
+def test_sharded_worlds_equal_single_envs(env_id: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Scenes spread over several PyBullet worlds (one scene each here) step as single envs."""
+    monkeypatch.setattr(batch_module, "SHARD_OBJECTS", 1)
+    vec = make_vec(env_id, 3)
+    try:
+        assert len(vec.unwrapped._batch.worlds) == 3
+    finally:
+        vec.close()
+    n, steps = SIZES.get(env_id, (3, 120))
+    assert run_pair(env_id, n, steps, max_episode_steps=30) >= 2
+
+
+def test_scenes_per_world() -> None:
+    assert batch_module.scenes_per_world(64, 1) == 8  # 8 objects per world
+    assert batch_module.scenes_per_world(8, 7) == 1
+    assert batch_module.scenes_per_world(8, 3) == 2
+    assert batch_module.scenes_per_world(256, 7) == 11  # at most MAX_WORLDS (24) worlds
+    assert batch_module.scenes_per_world(4, 40) == 1
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_small_batches_step_each_sub_env(env_id: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Below FAST_MIN_ENVS the sub-envs step by their own code (the goal env always does)."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 8)
+    vec = make_vec(env_id, 2)
+    try:
+        assert vec.unwrapped._batch.fast is None
+    finally:
+        vec.close()
+    assert run_pair(env_id, 2, 45, max_episode_steps=20) >= 2

@@ -12,9 +12,16 @@ import numpy as np
 import pytest
 
 from baselines import SGCExpert
+from sgc_env.envs import batch as batch_module
 from sgc_env.envs.batch import MAX_ENVS
 from sgc_env.envs.vector_env import SGCVectorEnv
 from sgc_env.simulator import connected_clients
+
+
+@pytest.fixture(autouse=True)
+def _numpy_step_from_one_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Small batches here step by the numpy path, as batches of FAST_MIN_ENVS or more do."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 1)
 
 
 def _rss_mb() -> float:

@@ -13,6 +13,13 @@ from stable_baselines3.common.vec_env import VecNormalize
 from baselines import SGCExpert
 from baselines.batched import BatchedVecEnv, make_sgc_vec
 from baselines.vector import base_env
+from sgc_env.envs import batch as batch_module
+
+
+@pytest.fixture(autouse=True)
+def _numpy_step_from_one_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Small batches here step by the numpy path, as batches of FAST_MIN_ENVS or more do."""
+    monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", 1)
 
 
 def _equal(a: object, b: object) -> bool:
@@ -37,6 +44,10 @@ def test_adapter_steps_as_dummy_vec_env(env_id: str) -> None:
             od, rd, dd, idd = dummy.step(actions)
             assert _equal(ob, od) and np.array_equal(rb, rd) and np.array_equal(db, dd)
             for b, d in zip(ib, idd, strict=True):
+                assert b.keys() == d.keys()  # the batched env's infos are filled when read
+                for key in d.keys() - {"episode", "terminal_observation", "goal_reached"}:
+                    assert np.array_equal(b[key], d[key]), key
+                assert b.get("goal_reached") == d.get("goal_reached")
                 assert b["TimeLimit.truncated"] == d["TimeLimit.truncated"]
                 assert ("terminal_observation" in b) == ("terminal_observation" in d)
                 if "terminal_observation" in d:

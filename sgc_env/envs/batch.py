@@ -1,16 +1,22 @@
-"""N sub-envs in one PyBullet world, stepped together: the core of both vector env APIs.
+"""N sub-envs in shared PyBullet worlds, stepped together: the core of both vector env APIs.
 
 Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) built on a
-:class:`~sgc_env.envs.world.WorldView` of one :class:`~sgc_env.envs.world.SharedWorld`, so its
-task logic, observation, reward and goal events are the single env's own code: a sub-env is a
-single env whose physics step is shared. A control step gathers every stepping sub-env's
-drives, runs the world's substeps once, then lets each sub-env observe. The Gymnasium
-(:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters differ only in their reset
-conventions and in how they batch what this returns.
+:class:`~sgc_env.envs.world.WorldView` of a :class:`~sgc_env.envs.world.SharedWorld`; the
+scenes are spread over worlds of about :data:`SHARD_OBJECTS` objects (why: there). A control
+step gathers every stepping sub-env's drives, runs each world's substeps once, then observes
+every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters
+differ only in their reset conventions and in how they batch what this returns.
 
 A sub-env that does not step in a call (it is being reset) still has bodies in the world that
 the substeps integrate; its reset comes after the physics and overwrites their state, so it
 starts exactly where a single env's reset would.
+
+Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one; :data:`FAST_MIN_ENVS` or
+more of them) step by the fast path,
+:meth:`Batch.step_fast`: the task work of all sub-envs at once in numpy
+(:class:`~sgc_env.envs.batch_task.BatchTask`), the sub-env objects brought up to date only
+when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
+``_finish_step`` (:meth:`Batch.step`).
 """
 
 from __future__ import annotations
@@ -22,17 +28,45 @@ import numpy as np
 from sgc_env.episode_steps import check_episode_length
 
 from .actuation import clip_action
+from .batch_task import BatchTask, GoalEvent
 from .sgc_env import SGCEnv
 from .world import SharedWorld
 
-__all__ = ["MAX_ENVS", "Batch", "check_num_envs"]
+__all__ = ["FAST_MIN_ENVS", "MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
+           "scenes_per_world"]  # fmt: skip
 
 MAX_ENVS = 1024
-"""Most sub-envs per world. Why a cap: memory stays near 1 GB for three-rod scenes (~1 MB each),
-larger worlds were never measured, and the per-step cost only grows with N (in
-scripts/bench_vec.py runs 256 rods were already slower per env-step than 64)."""
+"""Most sub-envs per batch. Why a cap: with at most :data:`MAX_WORLDS` worlds, more scenes
+crowd each world and its quadratic step cost (see :data:`SHARD_OBJECTS`) grows again; batches
+beyond it were never measured."""
 
 StepResult = tuple[Any, float, bool, bool, Any]
+
+
+SHARD_OBJECTS = 8
+"""Objects (bodies and props) per PyBullet world, about. Why shards: PyBullet's
+``stepSimulation`` costs O(objects^2) in one world even without collision shapes
+(scripts/bench_world_step.py: about 2 us per body-step in worlds of 4 to 8 bodies, 11 at 64,
+95 at 256), so the batch spreads its scenes over several worlds (clients); a world of one
+body pays the per-call overhead of a step (4 us)."""
+
+MAX_WORLDS = 24
+"""Most worlds per batch: each PyBullet client holds ~28 MB, so more scenes share a world
+once N scenes would need more (a 256-scene three-rod batch: 11 scenes of 7 objects per world,
+~1.25 GB resident with SB3 imported; 32 worlds took it to 1.48 GB)."""
+
+
+FAST_MIN_ENVS = 12
+"""Fewest sub-envs that step by the numpy path (:class:`BatchTask`): its few hundred numpy calls
+per step cost about the same for 1 sub-env as for 64 (~1.5 ms under load), more than a few
+sub-envs' own Python; measured against the per-sub-env path, numpy/per-sub-env env-steps/s
+were 0.31, 0.47, 0.90, 1.40 for 2, 4, 8, 16 rods and 0.45, 0.61, 1.07, 1.43 for three-rod
+scenes."""
+
+
+def scenes_per_world(num_envs: int, objects: int) -> int:
+    """Scenes per world for ``num_envs`` scenes of ``objects`` objects each."""
+    return max(1, SHARD_OBJECTS // max(objects, 1), -(-num_envs // MAX_WORLDS))
 
 
 def check_num_envs(num_envs: object) -> int:
@@ -48,7 +82,7 @@ def check_num_envs(num_envs: object) -> int:
 
 
 class Batch:
-    """The sub-envs of one world (see the module docstring)."""
+    """The sub-envs of one batch and their worlds (see the module docstring)."""
 
     def __init__(
         self,
@@ -62,36 +96,60 @@ class Batch:
         n = check_num_envs(num_envs)
         if kwargs.get("render_mode") is not None:
             raise ValueError("render_mode: the batched env does not render; use a single env")
-        self.world = SharedWorld(int(kwargs.get("sim_frequency", 240)))
-        self.envs: list[SGCEnv] = []
+        frequency = int(kwargs.get("sim_frequency", 240))
+        self.worlds = [SharedWorld(frequency)]
+        self._envs: list[SGCEnv] = []
+        self.closed = False
         try:
-            for _ in range(n):
-                self.envs.append(env_class(**kwargs, world=self.world))
+            self._envs.append(env_class(**kwargs, world=self.worlds[0]))
+            per_world = scenes_per_world(n, len(self._envs[0].sim.bodies))
+            for i in range(1, n):
+                if i % per_world == 0:
+                    self.worlds.append(SharedWorld(frequency))
+                self._envs.append(env_class(**kwargs, world=self.worlds[-1]))
         except BaseException:
             self.close()
             raise
-        first = self.envs[0]
+        first = self._envs[0]
         self.substeps = first.substeps
         self.action_shape: tuple[int, ...] = first._action_shape
         self.limit = (
             None if max_episode_steps is None or max_episode_steps == -1 else int(max_episode_steps)
         )
         self.env_id = env_id
-        self.elapsed = [0] * n
-        self.closed = False
+        self.elapsed = np.zeros(n, dtype=np.int64)
+        fast = env_class is SGCEnv and n >= FAST_MIN_ENVS
+        self.fast = BatchTask(self._envs) if fast else None
+        self._behind = False  # the sub-env objects lag the fast path's arrays
+        self._handed = False  # the sub-envs were handed out: reload the arrays from them
 
     def __len__(self) -> int:
-        return len(self.envs)
+        return len(self._envs)
+
+    @property
+    def envs(self) -> list[SGCEnv]:
+        """The sub-envs, up to date (read them through this property each time: between
+        calls the fast path keeps their per-step state in its arrays)."""
+        fast = self.fast
+        if fast is not None:
+            if self._behind:
+                for i in range(len(self._envs)):
+                    fast.sync(i)
+                self._behind = False
+            self._handed = True
+        return self._envs
 
     def reset_one(
         self, i: int, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Any, dict[str, Any]]:
         """Reset sub-env ``i`` (refusing an episode its time limit would cut short)."""
-        env = self.envs[i]
+        env = self._envs[i]
         try:
             obs, info = env.reset(seed=seed, options=options)
-        except ValueError as err:
+        except ValueError as err:  # a refused reset changes nothing (the env's own rule)
             raise ValueError(f"sub-env {i}: {err}") from err
+        if self.fast is not None:
+            self.fast.load(i)
         if self.env_id is not None:
             check_episode_length(self.env_id, self.limit, env.max_steps)
         self.elapsed[i] = 0
@@ -99,37 +157,63 @@ class Batch:
 
     def clip(self, actions: Any, indices: list[int]) -> list[list[float]]:
         """Each listed sub-env's action row, clipped; errors name the sub-env."""
+        return self.clip_rows(actions, indices).tolist()
+
+    def clip_rows(self, actions: Any, indices: list[int]) -> np.ndarray:
+        """:meth:`clip` as an array (rows, action) of the action's dtype."""
         a = actions if type(actions) is np.ndarray else np.asarray(actions)
-        shape = (len(self.envs), *self.action_shape)
+        shape = (len(self._envs), *self.action_shape)
         if a.shape != shape:
             raise ValueError(f"actions have shape {a.shape}, expected {shape} (num_envs, action)")
         rows = a[indices]
         if a.dtype.kind in "fiu" and np.isfinite(rows).all():
-            return np.clip(rows, -1, 1).tolist()  # as clip_action, one call for all rows
+            return np.clip(rows, -1, 1)  # as clip_action, one call for all rows
         out = []  # something is wrong: find the first bad row with the single env's check
         for i in indices:
             try:
                 out.append(clip_action(a[i], self.action_shape))
             except (TypeError, ValueError) as err:
                 raise type(err)(f"sub-env {i}: {err}") from None
-        return out
+        return np.array(out)
+
+    def step_fast(
+        self, indices: list[int], actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, list[GoalEvent]]]:
+        """:meth:`step` by the fast path (plain ``SGCEnv`` sub-envs): rewards, terminated and
+        truncated over all sub-envs (rows not listed hold stale values: reset them next) and
+        the goal events by sub-env; observations and records in ``fast.obs`` / ``fast.rec``."""
+        fast = self.fast
+        assert fast is not None
+        values = self.clip_rows(actions, indices).astype(np.float64)
+        if self._handed:  # a sub-env may have been pushed or changed: start from the objects
+            for i in range(len(self._envs)):
+                fast.load(i, record=False)
+            self._handed = False
+        rewards, terminated, at_limit, events = fast.step(indices, values)
+        self._behind = True
+        truncated = ~terminated & at_limit
+        self.elapsed[indices] += 1
+        if self.limit is not None:
+            truncated |= self.elapsed >= self.limit
+        return rewards, terminated, truncated, events
 
     def step(self, indices: list[int], values: list[list[float]]) -> list[StepResult]:
         """One control step of the listed sub-envs (their clipped actions) in one world step;
         the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
-        envs = self.envs
-        drives: list[Any] = []
-        moves: list[list[Any]] = [[] for _ in range(self.substeps)]
-        any_moves = False
+        envs = self._envs
+        by_world: dict[int, tuple[list[Any], list[list[Any]]]] = {}
         for i, v in zip(indices, values, strict=True):
             d, m = envs[i]._drives(v)
+            drives, moves = by_world.setdefault(
+                envs[i].sim.client, ([], [[] for _ in range(self.substeps)])
+            )
             drives += d
-            if m:
-                any_moves = True
-                for k, mk in enumerate(m):
-                    moves[k] += mk
-        if drives:
-            self.world.sim.step_bodies(drives, moves if any_moves else ())
+            for k, mk in enumerate(m):
+                moves[k] += mk
+        for world in self.worlds:
+            if world.client in by_world:
+                drives, moves = by_world[world.client]
+                world.sim.step_bodies(drives, moves if any(moves) else ())
         results = []
         limit, elapsed = self.limit, self.elapsed
         for i, v in zip(indices, values, strict=True):
@@ -142,7 +226,8 @@ class Batch:
 
     def close(self) -> None:
         """Close every sub-env and free the client (idempotent)."""
-        for env in self.envs:
+        for env in self._envs:
             env.close()
-        self.world.close()
+        for world in self.worlds:
+            world.close()
         self.closed = True

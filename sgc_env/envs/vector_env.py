@@ -1,8 +1,8 @@
 """The batched env as a Gymnasium 1.x ``VectorEnv``: every registered id's vector entry point.
 
 ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` builds N sub-envs
-in one PyBullet client (:mod:`.batch`); each sub-env's observations, rewards, flags and goal
-events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
+in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags
+and goal events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
 (tests/test_batched.py). Conventions:
 
 - ``single_observation_space`` / ``single_action_space``; batched spaces from Gymnasium;
@@ -29,6 +29,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
 from .batch import Batch
+from .batch_infos import vector_infos
 from .goal_env import SGCGoalEnv
 from .sgc_env import SGCEnv
 
@@ -70,7 +71,7 @@ def batch_infos(infos: list[dict[str, Any]], indices: list[int], n: int) -> dict
 
 
 class SGCVectorEnv(VectorEnv):
-    """``num_envs`` SGC envs in one PyBullet world (see the module docstring); the other
+    """``num_envs`` SGC envs in shared PyBullet worlds (see the module docstring); the other
     keyword arguments are the single env's (``gym.make(id, **kwargs)``)."""
 
     env_class: type[SGCEnv] = SGCEnv
@@ -130,7 +131,9 @@ class SGCVectorEnv(VectorEnv):
             self._obs[i], info = self._batch.reset_one(i, seeds[i], options or None)
             infos.append(info)
             self._autoreset[i] = False
-        return self._stack(self._obs), batch_infos(infos, indices, n)
+        fast = self._batch.fast
+        obs = self._stack(self._obs) if fast is None else fast.share()[0]
+        return obs, batch_infos(infos, indices, n)
 
     def step(self, actions: Any) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
         self._check_open()
@@ -139,6 +142,8 @@ class SGCVectorEnv(VectorEnv):
             raise RuntimeError("call reset() before step() on the batched env")
         resetting = np.flatnonzero(self._autoreset).tolist()
         stepping = np.flatnonzero(~self._autoreset).tolist()
+        if self._batch.fast is not None:
+            return self._step_fast(actions, stepping, resetting)
         values = self._batch.clip(actions, stepping)
         rewards = np.zeros(n)
         terminated = np.zeros(n, dtype=bool)
@@ -158,6 +163,23 @@ class SGCVectorEnv(VectorEnv):
             self._stack(self._obs), rewards, terminated, truncated,
             batch_infos(infos, stepping + resetting, n),
         )  # fmt: skip
+
+    def _step_fast(
+        self, actions: Any, stepping: list[int], resetting: list[int]
+    ) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict]:
+        """:meth:`step` of plain SGC sub-envs: arrays from the batch's shared buffers."""
+        batch = self._batch
+        rewards, terminated, truncated, events = batch.step_fast(stepping, actions)
+        for i in resetting:  # after the physics: see sgc_env.envs.batch
+            self._obs[i] = batch.reset_one(i)[0]
+        if resetting:
+            rewards[resetting] = 0.0
+            terminated[resetting] = truncated[resetting] = False
+        assert batch.fast is not None
+        obs, _ = batch.fast.share()
+        infos = vector_infos(batch.fast, events)
+        self._autoreset = terminated | truncated
+        return obs, rewards, terminated, truncated, infos
 
     def render(self) -> None:
         raise NotImplementedError(
