@@ -68,6 +68,36 @@ def test_wrapper_adds_the_smooth_minus_capped_cost_and_keeps_the_rest() -> None:
     shaped.close()
 
 
+def test_alive_turns_the_failure_charge_into_a_per_step_bonus() -> None:
+    def make() -> DummyVecEnv:
+        venv = DummyVecEnv([lambda: gym.make("SGCRod-v0")])
+        venv.seed(3)
+        return venv
+
+    plain, alive = make(), SmoothScheduleCost(make(), alive=True)
+    plain.reset()
+    alive.reset()
+    action = np.array([[0.0, 0.0, -0.5, 0.1, 0.0, 0.0]], dtype=np.float32)  # falls out
+    worst = 2 + 0.01  # two tracks, one body, plus the effort weight
+    for _ in range(200):
+        obs, r, dones, infos = plain.step(action)
+        _, r_a, _, _ = alive.step(action)
+        after = infos[0]["terminal_observation"] if dones[0] else obs[0]
+        x = schedule_offsets(np.asarray(after)[None])[0, 0]
+        effort = 0.01 * float(np.mean(action**2))
+        if dones[0]:
+            assert not infos[0]["TimeLimit.truncated"]
+            assert r[0] < -100  # the env charged the steps left in one lump
+            np.testing.assert_allclose(r_a[0], worst - (x / (1 + x)).sum() - effort, atol=1e-5)
+            break
+        np.testing.assert_allclose(r_a[0], r[0] + np.minimum(x, 1).sum() - (x / (1 + x)).sum()
+                                   + worst, atol=1e-5)  # fmt: skip
+    else:
+        raise AssertionError("the falling rod never left the workspace")
+    plain.close()
+    alive.close()
+
+
 def test_recipe_field_and_bad_values(tmp_path: Path) -> None:
     folder = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams" / "ppo_rod_smooth"
     assert load_hyperparams("ppo", "SGCRod-v0", folder).reward_shaping == "smooth"

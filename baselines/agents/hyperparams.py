@@ -230,8 +230,9 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs and noise_std must be finite "
                          "numbers") from None  # fmt: skip
     shaping = entry.get("reward_shaping", "none")
-    if shaping not in ("none", "smooth"):
-        raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none' or 'smooth', "
+    if shaping not in ("none", "smooth", "smooth_alive"):
+        raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none', 'smooth' or "
+                         f"'smooth_alive', "
                          f"got {shaping!r}")  # fmt: skip
     if not isinstance(entry["policy"], str):
         raise ValueError(f"{path}: {env_id}: policy must be a name such as MlpPolicy")

@@ -11,6 +11,14 @@ slope at the schedule, still below 1 everywhere (so the failure charge stays the
 strictly increasing, so "less far off" pays at every distance. It reads only the observation,
 is applied to the training envs only (evaluation scores goals, not rewards) and sits below
 ``VecNormalize``.
+
+``alive=True`` (``reward_shaping: smooth_alive``) also trades the failure charge (one lump of
+the worst per-step reward times the steps left, up to ~-600 on the rod, at a random step) for
+the same worst per-step reward paid as a bonus on every step the episode lives: undiscounted,
+the return differs from the charged one by that bonus times the episode's length, a constant
+of the scenario, so the ranking of policies is the same, but the value function no longer has
+to predict when a lump lands. A terminated step's reward is recomputed without the charge (its
+goal bonus, which a failing tick almost never has, is dropped with it).
 """
 
 from __future__ import annotations
@@ -20,7 +28,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
 
-from sgc_env.envs.rewards import ORIENTATION_FLOOR, POSITION_FLOOR
+from sgc_env.envs.rewards import EFFORT_WEIGHT, ORIENTATION_FLOOR, POSITION_FLOOR
 from sgc_env.observation import BODY_BLOCK_SIZE, GLOBAL_FIELDS, ObservationLayout
 
 __all__ = ["SmoothScheduleCost", "schedule_offsets"]
@@ -60,14 +68,21 @@ def schedule_offsets(obs: np.ndarray) -> np.ndarray:
 
 
 class SmoothScheduleCost(VecEnvWrapper):
-    """Adds ``mean_b sum_tracks (min(x, 1) - x / (1 + x))`` to the env's reward (see above)."""
+    """Adds ``mean_b sum_tracks (min(x, 1) - x / (1 + x))`` to the env's reward; with ``alive``
+    the failure charge becomes a per-step bonus (see above)."""
 
-    def __init__(self, venv: VecEnv) -> None:
+    def __init__(self, venv: VecEnv, alive: bool = False) -> None:
         super().__init__(venv)
         _n_bodies(int(np.prod(venv.observation_space.shape or (0,))))
+        self.alive = alive
+        self._actions = np.zeros((venv.num_envs, *(venv.action_space.shape or ())))
 
     def reset(self) -> Any:
         return self.venv.reset()
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = np.clip(np.asarray(actions, dtype=np.float64), -1.0, 1.0)
+        self.venv.step_async(actions)
 
     def step_wait(self) -> Any:
         obs, rewards, dones, infos = self.venv.step_wait()
@@ -75,5 +90,14 @@ class SmoothScheduleCost(VecEnvWrapper):
         for i in np.flatnonzero(dones):  # the state the reward was computed on
             after[i] = infos[i]["terminal_observation"]
         x = schedule_offsets(after)
-        delta = np.nan_to_num(np.minimum(x, 1.0) - x / (1.0 + x)).sum(axis=2).mean(axis=1)
-        return obs, rewards + delta.astype(rewards.dtype), dones, infos
+        capped = np.nan_to_num(np.minimum(x, 1.0)).sum(axis=2).mean(axis=1)
+        smooth = np.nan_to_num(x / (1.0 + x)).sum(axis=2).mean(axis=1)
+        shaped = rewards + capped - smooth
+        if self.alive:
+            effort = EFFORT_WEIGHT * np.mean(self._actions.reshape(len(dones), -1) ** 2, axis=1)
+            for i in np.flatnonzero(dones):
+                if not infos[i].get("TimeLimit.truncated", False):  # failed: drop the charge
+                    shaped[i] = -smooth[i] - effort[i]
+            worst = (~np.isnan(x)).sum(axis=2).mean(axis=1) + EFFORT_WEIGHT
+            shaped = shaped + worst
+        return obs, shaped.astype(rewards.dtype), dones, infos
