@@ -163,3 +163,24 @@ def test_ppo_on_the_features_learns_point_goals_from_scratch(tmp_path: Path) -> 
         )  # fmt: skip
     )
     assert result.evaluations[-1]["success_rate"] >= 0.5
+
+
+def test_squash_bounds_the_error_and_its_rate_and_keeps_the_rest() -> None:
+    env = gym.make("SGCRod-v0")
+    plain = ScheduleFeatures(env.observation_space)
+    squashed = ScheduleFeatures(env.observation_space, squash=3.0)
+    obs, _ = env.reset(seed=1)
+    for _ in range(40):  # full thrust up and spin: the body runs far off its schedule
+        obs, *_ = env.step(np.array([0, 0, 1, 1, 0, 0], dtype=np.float32))
+    raw, out = _features(plain, obs), _features(squashed, obs)
+    n = TRACK_FEATURES
+    errors = np.r_[0:6, n : n + 6]  # error and rate of both tracks
+    assert np.abs(raw[errors]).max() > 10  # far off: the unsquashed inputs are large
+    np.testing.assert_allclose(out[errors], 3.0 * np.tanh(raw[errors] / 3.0), rtol=1e-5, atol=1e-6)
+    assert np.abs(out[errors]).max() <= 3.0
+    rest = np.setdiff1d(np.arange(raw.size), errors)
+    np.testing.assert_array_equal(out[rest], raw[rest])
+    for bad in (0.0, -1.0, "3"):
+        with pytest.raises(ValueError, match="squash"):
+            ScheduleFeatures(env.observation_space, squash=bad)  # type: ignore[arg-type]
+    env.close()

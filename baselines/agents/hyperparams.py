@@ -31,7 +31,8 @@ __all__ = [
 
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
 _STRING_KWARGS = ("policy_kwargs", "replay_buffer_kwargs")
-_ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std"}
+_ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std",
+             "reward_shaping"}  # fmt: skip
 
 
 @dataclass
@@ -49,6 +50,7 @@ class Hyperparams:
     noise_std: float = 0.1
     algo_kwargs: dict[str, Any] = field(default_factory=dict)
     raw: dict[str, Any] = field(default_factory=dict)
+    reward_shaping: str = "none"  # training envs only (baselines/agents/shaping.py)
 
 
 def _resolve_name(dotted: str, field_name: str) -> Any:
@@ -227,6 +229,11 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
     except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs and noise_std must be finite "
                          "numbers") from None  # fmt: skip
+    shaping = entry.get("reward_shaping", "none")
+    if shaping not in ("none", "smooth", "smooth_alive"):
+        raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none', 'smooth' or "
+                         f"'smooth_alive', "
+                         f"got {shaping!r}")  # fmt: skip
     if not isinstance(entry["policy"], str):
         raise ValueError(f"{path}: {env_id}: policy must be a name such as MlpPolicy")
     if n_envs < 1:
@@ -243,4 +250,5 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         noise_std=noise_std,
         algo_kwargs=kwargs,
         raw=dict(entry),
+        reward_shaping=shaping,
     )

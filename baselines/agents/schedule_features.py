@@ -17,7 +17,11 @@ this difference from raw metres and seconds through an MLP spends most of its bu
 | flags (has the track, current goal is the last) | 2 | - |
 
 then the gravity term of each body (``m g / force_limit``, the action that hovers it, given at
-construction). The precision residuals and absolute positions are dropped. Why a features
+construction). The precision residuals and absolute positions are dropped. ``squash=c`` maps
+the error and its rate through ``c tanh(x / c)``: linear within a few units (the tolerances
+are ~0.4 of a unit), bounded at ``c`` when a body is far off its schedule, so a ReLU or linear
+policy is not handed inputs of 20-100 (a body metres off) that blow up its first updates
+(`ppo-fast-linear` diverged, approx KL 12). Default ``None``: unchanged. Why a features
 extractor rather than an observation wrapper: it is saved inside the SB3 ``.zip``, so a model
 evaluates on the plain env id with nothing else to restore, and the expert's interface (the raw
 observation) stays as it is. It needs the raw observation: combine it with
@@ -54,7 +58,10 @@ class ScheduleFeatures(BaseFeaturesExtractor):
     gravity: th.Tensor
 
     def __init__(
-        self, observation_space: gym.spaces.Box, gravity: Sequence[float] | float = 0.0981
+        self,
+        observation_space: gym.spaces.Box,
+        gravity: Sequence[float] | float = 0.0981,
+        squash: float | None = None,
     ) -> None:
         if not isinstance(observation_space, gym.spaces.Box) or len(observation_space.shape) != 1:
             raise ValueError(f"ScheduleFeatures needs a flat Box, got {observation_space}")
@@ -66,6 +73,9 @@ class ScheduleFeatures(BaseFeaturesExtractor):
                 f"ScheduleFeatures: an observation of {size} entries is not an SGC layout "
                 f"(n * {BODY_BLOCK_SIZE} + {n_globals})"
             )
+        if squash is not None and not (isinstance(squash, (int, float)) and squash > 0):
+            raise ValueError(f"squash: expected a number > 0 or None, got {squash!r}")
+        self.squash = None if squash is None else float(squash)
         if isinstance(gravity, (int, float)):
             gravity = [float(gravity)] * n_bodies
         weights = [float(g) for g in gravity]
@@ -101,10 +111,15 @@ class ScheduleFeatures(BaseFeaturesExtractor):
         )  # fmt: skip
         has_track = flags[..., :1]
         fraction = th.where(in_course, (time_left / duration).clamp(0.0, 1.0), 0.0)
+        error = (deviation - schedule) / _ERROR_SCALE
+        error_rate = (rate - schedule_rate) / _RATE_SCALE
+        if self.squash is not None:
+            error = self.squash * th.tanh(error / self.squash)
+            error_rate = self.squash * th.tanh(error_rate / self.squash)
         return th.cat(
             [
-                has_track * (deviation - schedule) / _ERROR_SCALE,
-                has_track * (rate - schedule_rate) / _RATE_SCALE,
+                has_track * error,
+                has_track * error_rate,
                 has_track * schedule_rate,
                 has_track * next_rate,
                 has_track * fraction,

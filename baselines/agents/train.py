@@ -154,6 +154,10 @@ def train(cfg: TrainConfig) -> TrainResult:
     total = hp.n_timesteps if cfg.timesteps is None else int(cfg.timesteps)
     set_random_seed(cfg.seed)
     env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs, cfg.vec)
+    if hp.reward_shaping != "none":
+        from baselines.agents.shaping import SmoothScheduleCost
+
+        env = SmoothScheduleCost(env, alive=hp.reward_shaping == "smooth_alive")
     if hp.normalize:
         env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
     kwargs = dict(hp.algo_kwargs)
