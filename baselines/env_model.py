@@ -105,3 +105,4 @@ class EnvModel:
                 bx, by, bz = quat.rotate_back(q, torque)
                 out += quat.rotate(q, (bx / sx, by / sy, bz / sz))
         return np.array([-1.0 if x < -1.0 else 1.0 if x > 1.0 else x for x in out])
+

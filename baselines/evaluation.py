@@ -263,12 +263,8 @@ def summarize(
         "angular_velocity_jump_max": _max(c["angular_velocity_jump_max"] for c in cards),
         **{
             f"{key}_max": _max(c[key] for c in cards)
-            for key in (
-                "acceleration_peak",
-                "acceleration_kink",
-                "angular_acceleration_peak",
-                "angular_acceleration_kink",
-            )
+            for key in ("acceleration_peak", "acceleration_kink", "angular_acceleration_peak",
+                        "angular_acceleration_kink")
         },  # fmt: skip
         "speed_minima_mean": _mean(c["speed_minima_total"] for c in cards),
         "goal_speed_ratio_min": _min(b["goal_speed_ratio_min"] for b in bodies),

@@ -152,14 +152,9 @@ def record_minari(
                 done = terminated or truncated
             buffers.append(
                 EpisodeBuffer(
-                    id=k,
-                    seed=seed + k,
-                    observations=np.stack(observations),
-                    actions=np.stack(actions),
-                    rewards=rewards,
-                    terminations=terminations,
-                    truncations=truncations,
-                    infos=_stack_infos(infos),
+                    id=k, seed=seed + k, observations=np.stack(observations),
+                    actions=np.stack(actions), rewards=rewards, terminations=terminations,
+                    truncations=truncations, infos=_stack_infos(infos),
                 )  # fmt: skip
             )
         return _write_in_place(

@@ -78,9 +78,7 @@ class LocalBackend:
         self.description = f"local process pool, {workers} worker(s)"
 
     def run(
-        self,
-        specs: Sequence[dict[str, Any]],
-        on_start: Started | None = None,
+        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None,
         claim: Claim | None = None,
     ) -> Iterator[dict[str, Any]]:
         """Yield each run's outcome as it finishes (``on_start(run_id)`` when one begins,
@@ -143,9 +141,7 @@ class RayBackend:
         return True
 
     def run(
-        self,
-        specs: Sequence[dict[str, Any]],
-        on_start: Started | None = None,
+        self, specs: Sequence[dict[str, Any]], on_start: Started | None = None,
         claim: Claim | None = None,
     ) -> Iterator[dict[str, Any]]:
         """Submit every run as a task and yield outcomes in the order they finish."""

@@ -122,7 +122,9 @@ def ball_indices(scenario: Any) -> list[int]:
     return [names.index(f"ball_{b.name[4:]}") for b in scenario.bodies]
 
 
-def pierce_times(scenario: Any, times: Sequence[float], tips: np.ndarray) -> list[float | None]:
+def pierce_times(
+    scenario: Any, times: Sequence[float], tips: np.ndarray
+) -> list[float | None]:
     """When each rod pierced its ball: None if its tip never came within the ball's radius of
     the ball's centre, else the tick of closest approach within the first such contact.
 
@@ -303,7 +305,9 @@ _SMOOTHNESS_KEYS = (
 """The harness's whole-track smoothness figures each rod's row carries (docs/metrics.md)."""
 
 
-def _per_rod(record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any) -> list[dict[str, Any]]:
+def _per_rod(
+    record: Any, rows: Sequence[Mapping[str, Any]], scenario: Any
+) -> list[dict[str, Any]]:
     """Exactness, punctuality and smoothness for each rod, from the harness's rows and card."""
     out = []
     for b, body in enumerate(scenario.bodies):

@@ -98,11 +98,8 @@ def run(args: argparse.Namespace) -> int:
         trust = trust_model(args, "demo")
         options = [
             DemoOptions(
-                out=args.out,
-                width=args.width,
-                height=args.height,
-                video=not args.no_video,
-                policy=spec,
+                out=args.out, width=args.width, height=args.height,
+                video=not args.no_video, policy=spec,
                 end_rule="paper" if args.paper_rule and spec == "expert" else "tangent",
                 trust_model=trust,
             )  # fmt: skip

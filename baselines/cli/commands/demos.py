@@ -48,7 +48,9 @@ def push_options(args: argparse.Namespace) -> dict[str, Any]:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--env", required=True, help="registered id with a flat observation")
     parser.add_argument("--episodes", type=positive_int, required=True, help="how many episodes")
-    parser.add_argument("--seed", type=nonneg_int, default=0, help="episodes use seed, seed+1, ...")
+    parser.add_argument(
+        "--seed", type=nonneg_int, default=0, help="episodes use seed, seed+1, ..."
+    )
     parser.add_argument("--out", required=True, help="output .npz, or the Minari dataset id")
     parser.add_argument(
         "--format", choices=("npz", "minari"), default="npz",

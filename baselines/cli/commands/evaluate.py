@@ -115,7 +115,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
         "id (default: SGCPoint-v0)",
     )  # fmt: skip
-    parser.add_argument("--episodes", type=positive_int, default=5, help="episodes per pair")
+    parser.add_argument(
+        "--episodes", type=positive_int, default=5, help="episodes per pair"
+    )
     parser.add_argument(
         "--seed", type=nonneg_int, default=EVAL_SEED,
         help="episode k uses seed + k",

@@ -59,7 +59,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--init", choices=("none", "bc"), default="none", help="bc: clone --demos first"
     )
     parser.add_argument("--demos", type=existing_file, default=None, help="npz from `sgc demos`")
-    parser.add_argument("--bc-epochs", type=nonneg_int, default=30, help="behaviour-cloning epochs")
+    parser.add_argument(
+        "--bc-epochs", type=nonneg_int, default=30, help="behaviour-cloning epochs"
+    )
     parser.add_argument(
         "--bc-log-std", type=float, default=-2.0, help="PPO exploration after cloning"
     )
