@@ -109,7 +109,7 @@ def record_minari(
     """Roll out the expert on seeds ``seed .. seed+episodes-1`` into Minari ``dataset_id``.
 
     Written under Minari's datasets folder (``MINARI_DATASETS_PATH``, else
-    ``~/.minari/datasets``); an existing dataset of that id is an error (Minari's own rule).
+    ``~/.minari/datasets``); an existing dataset of that id is an error (a ``ValueError``).
     ``publisher``: Minari's ``author``, ``author_email``, ``code_permalink`` (Minari warns
     when they are missing).
     """

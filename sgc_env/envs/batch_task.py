@@ -36,8 +36,8 @@ from .rewards import (
     ORIENTATION_FLOOR,
     POSITION_FLOOR,
     TRACK_COST_CAP,
+    goal_bonus,
 )  # fmt: skip
-from .rewards import _bonus as goal_bonus
 from .sgc_env import MAX_SPEED, SPIN_CLAMP, SGCEnv
 from .task import GoalEvent
 

@@ -55,6 +55,7 @@ __all__ = [
     "SparseReward",
     "TrackState",
     "distance_cost",
+    "goal_bonus",
     "make_reward",
     "schedule_cost",
     "tracks_of",
@@ -78,7 +79,8 @@ def _effort(action: Sequence[float]) -> float:
     return EFFORT_WEIGHT * sum([x * x for x in action]) / len(action)
 
 
-def _bonus(events: Sequence[GoalEvent]) -> float:
+def goal_bonus(events: Sequence[GoalEvent]) -> float:
+    """The bonuses of the goals met this tick (the module docstring; the batched env's too)."""
     total = 0.0
     for ev in events:
         if ev["position_error"] is not None:
@@ -148,7 +150,7 @@ class _ModeReward:
                 cost += self._cost(track, floor)
                 worst += TRACK_COST_CAP
         n = task.n_bodies
-        reward = -cost / n - _effort(action) + _bonus(events)
+        reward = -cost / n - _effort(action) + goal_bonus(events)
         if terminated and self._charge:
             reward -= (worst / n + EFFORT_WEIGHT) * steps_left
         return reward
