@@ -11,6 +11,7 @@ distribution and the expert's feedback is what corrects that drift.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Any, cast
 
@@ -168,12 +169,14 @@ def dagger(
     learning_rate: float = 1e-3,
     log_std: float | None = -2.0,
     pushes: Pushes | None = None,
+    deadline: float | None = None,
 ) -> tuple[Demonstrations, BCResult]:
     """``rounds`` of: roll out the clone, relabel with the expert, refit on the aggregate.
 
     Rollout seeds are ``seed + 1_000_000 + r * episodes_per_round + i`` so they never overlap
     the demonstration or held-out evaluation seeds. ``pushes`` knock the clone off its own
     path during the rollouts (see :mod:`baselines.agents.pushes`); the default pushes nothing.
+    No round starts once ``time.perf_counter()`` has passed ``deadline`` (a wall-clock budget).
     """
     from baselines.policies import make_policy
 
@@ -186,6 +189,8 @@ def dagger(
     try:
         expert = make_policy("expert", env)
         for r in range(rounds):
+            if deadline is not None and time.perf_counter() >= deadline:
+                break
             first = seed + 1_000_000 + r * episodes_per_round
             seeds = np.arange(first, first + episodes_per_round)
             states, labels = _label_rollouts(model, env, expert, seeds, pushes or Pushes())

@@ -52,7 +52,13 @@ def score_key(summary: dict[str, Any]) -> tuple[float, float]:
 
 
 class HarnessEvalCallback(BaseCallback):
-    """Every ``eval_freq`` env steps: score on held-out seeds, log, keep the best model."""
+    """Every ``eval_freq`` env steps (or ``every_s`` seconds of training): score on held-out
+    seeds, log, keep the best model.
+
+    Each entry of ``history`` holds ``timesteps`` and ``train_time_s``, the seconds of training
+    since ``started`` (a ``time.perf_counter()`` reading; default: the start of ``learn()``)
+    less the evaluations themselves, so curves can be drawn against steps and wall clock.
+    """
 
     def __init__(
         self,
@@ -64,12 +70,18 @@ class HarnessEvalCallback(BaseCallback):
         best_model_dir: str | Path | None = None,
         vec_normalize: Any | None = None,
         verbose: int = 0,
+        every_s: float | None = None,
+        started: float | None = None,
     ) -> None:
         super().__init__(verbose)
-        if eval_freq < 1 or n_eval_episodes < 1:
+        if (eval_freq < 1 and every_s is None) or n_eval_episodes < 1:
             raise ValueError(
                 f"eval_freq and eval_episodes must be >= 1, got {eval_freq}, {n_eval_episodes}"
             )
+        if every_s is not None and not (math.isfinite(every_s) and every_s > 0):
+            raise ValueError(f"every_s must be a finite number of seconds > 0, got {every_s}")
+        self.every_s = every_s
+        self.started = started
         self.env_id = env_id
         self.eval_freq = int(eval_freq)
         self.n_eval_episodes = int(n_eval_episodes)
@@ -80,7 +92,18 @@ class HarnessEvalCallback(BaseCallback):
         self.best_score: tuple[float, float] = (-math.inf, -math.inf)
         self.history: list[dict[str, Any]] = []
         self._last_eval = 0
+        self._next_eval_s = every_s
         self.eval_time_s = 0.0
+
+    def train_time_s(self) -> float:
+        """Seconds of training so far, the evaluations taken off."""
+        if self.started is None:
+            return 0.0
+        return time.perf_counter() - self.started - self.eval_time_s
+
+    def _on_training_start(self) -> None:
+        if self.started is None:
+            self.started = time.perf_counter()
 
     def _policy(self) -> Any:
         if self.vec_normalize is not None:
@@ -91,6 +114,7 @@ class HarnessEvalCallback(BaseCallback):
         """Run the harness once and record the result (also used after training)."""
         from baselines.evaluation import evaluate
 
+        train_time = self.train_time_s()
         started = time.perf_counter()
         result = evaluate(
             self._policy(), self.env_id, self.n_eval_episodes, self.seed,
@@ -101,7 +125,7 @@ class HarnessEvalCallback(BaseCallback):
         flat = _scalar_items(summary)
         for key, value in flat.items():
             self.logger.record(f"eval/{key}", value)
-        entry = {"timesteps": int(self.num_timesteps), **flat}
+        entry = {"timesteps": int(self.num_timesteps), "train_time_s": train_time, **flat}
         self.history.append(entry)
         score = score_key(summary)
         if score > self.best_score:
@@ -119,8 +143,18 @@ class HarnessEvalCallback(BaseCallback):
             print(f"eval @ {self.num_timesteps}: {json.dumps(flat, sort_keys=True)}")
         return summary
 
+    def _due(self) -> bool:
+        if self._next_eval_s is not None:
+            if self.train_time_s() < self._next_eval_s:
+                return False
+            assert self.every_s is not None
+            while self._next_eval_s <= self.train_time_s():
+                self._next_eval_s += self.every_s
+            return True
+        return self.num_timesteps - self._last_eval >= self.eval_freq
+
     def _on_step(self) -> bool:
-        if self.num_timesteps - self._last_eval >= self.eval_freq:
+        if self._due():
             self._last_eval = self.num_timesteps
             self.evaluate_now()
             self.logger.dump(self.num_timesteps)

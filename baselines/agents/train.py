@@ -64,6 +64,8 @@ class TrainConfig:
     verbose: int = 0
     command: str = ""
     vec: str | None = None  # batched | dummy | subproc; None: batched where the id has it
+    time_budget_s: float | None = None  # stop training after this many seconds (budget.py)
+    eval_every_s: float | None = None  # curve points every this many seconds of training
 
 
 @dataclass
@@ -97,6 +99,8 @@ def _action_noise(hp, action_space: gym.spaces.Box):
 
 
 def _validate(cfg: TrainConfig) -> None:
+    from baselines.agents.budget import check_time_budget
+
     algorithm_class(cfg.algo)
     check_env_kwargs(cfg.env_id, cfg.env_kwargs, "env_kwargs")
     if cfg.init not in ("none", "bc"):
@@ -106,6 +110,8 @@ def _validate(cfg: TrainConfig) -> None:
             raise ValueError("demos: --init bc needs --demos FILE (see `sgc demos`)")
         if cfg.algo == "her":
             raise ValueError("init: behaviour cloning needs a flat observation; not for her")
+    check_time_budget(cfg.time_budget_s)
+    check_time_budget(cfg.eval_every_s, "eval_every_s")
     if cfg.timesteps is not None and cfg.timesteps < 0:
         raise ValueError(f"timesteps must be >= 0, got {cfg.timesteps}")
     if cfg.eval_freq < 0 or cfg.checkpoint_freq < 0 or cfg.critic_warmup < 0:
@@ -139,6 +145,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
+    from baselines.agents.budget import TimeBudgetCallback
     from baselines.agents.callbacks import (
         FreezeActorCallback,
         HarnessEvalCallback,
@@ -181,8 +188,10 @@ def train(cfg: TrainConfig) -> TrainResult:
     except (TypeError, ValueError, AssertionError) as exc:  # values SB3 itself refuses
         raise ValueError(f"hyperparameters of {cfg.algo} for {cfg.env_id}: {exc}") from None
     bc_info = None
+    train_started = time.perf_counter()  # the budget's clock: cloning counts as training
     if cfg.init == "bc":
-        bc_info = _clone(model, cfg)
+        deadline = None if cfg.time_budget_s is None else train_started + cfg.time_budget_s
+        bc_info = _clone(model, cfg, deadline)
     callbacks: list[BaseCallback] = []
     if cfg.critic_warmup:
         callbacks.append(FreezeActorCallback(cfg.critic_warmup))
@@ -194,22 +203,31 @@ def train(cfg: TrainConfig) -> TrainResult:
             )
         )  # fmt: skip
     eval_cb = None
-    if cfg.eval_freq:
+    if cfg.eval_freq or cfg.eval_every_s is not None:
         eval_cb = HarnessEvalCallback(
             cfg.env_id, cfg.eval_freq, cfg.eval_episodes, seed=cfg.eval_seed,
             env_kwargs=cfg.env_kwargs, best_model_dir=out,
             vec_normalize=env if hp.normalize else None, verbose=cfg.verbose,
+            every_s=cfg.eval_every_s, started=train_started,
         )  # fmt: skip
         callbacks.append(eval_cb)
+    budget_cb = None
+    if cfg.time_budget_s is not None:
+        budget_cb = TimeBudgetCallback(
+            cfg.time_budget_s, started=train_started, excluded=(eval_cb,) if eval_cb else ()
+        )
+        callbacks.append(budget_cb)
     learn_started = time.perf_counter()
-    if total > 0:
+    if total > 0 and not (budget_cb is not None and budget_cb.spent()):
         model.learn(
             total, callback=CallbackList(callbacks), progress_bar=cfg.progress,
             tb_log_name=f"{cfg.algo}_{cfg.env_id}_seed{cfg.seed}",
         )  # fmt: skip
     learn_time = time.perf_counter() - learn_started
+    train_time = time.perf_counter() - train_started
     if eval_cb is not None:
         learn_time -= eval_cb.eval_time_s
+        train_time -= eval_cb.eval_time_s
     steps = int(model.num_timesteps)
     config = {
         "algo": cfg.algo,
@@ -217,6 +235,9 @@ def train(cfg: TrainConfig) -> TrainResult:
         "env_id": cfg.env_id,
         "seed": cfg.seed,
         "timesteps": total,
+        "steps_reached": steps,
+        "time_budget_s": cfg.time_budget_s,
+        "budget_spent": budget_cb is not None and budget_cb.spent_out,
         "hyperparams": _jsonable(hp.raw),
         "train_config": _jsonable(asdict(cfg)),
         "command": cfg.command,
@@ -238,7 +259,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         result.evaluations = eval_cb.history
     result.wall_time_s = time.perf_counter() - started
     config.update(
-        wall_time_s=result.wall_time_s, learn_time_s=learn_time,
+        wall_time_s=result.wall_time_s, learn_time_s=learn_time, train_time_s=train_time,
         steps_per_s=result.steps_per_s, evaluations=result.evaluations,
     )  # fmt: skip
     if out is not None:
@@ -250,8 +271,9 @@ def train(cfg: TrainConfig) -> TrainResult:
     return result
 
 
-def _clone(model: Any, cfg: TrainConfig) -> dict[str, Any]:
-    """Behaviour-clone (and optionally DAgger) the new model's actor from ``cfg.demos``."""
+def _clone(model: Any, cfg: TrainConfig, deadline: float | None = None) -> dict[str, Any]:
+    """Behaviour-clone (and optionally DAgger) the new model's actor from ``cfg.demos``;
+    no DAgger round starts after ``deadline`` (a ``time.perf_counter()`` reading)."""
     from baselines.agents.bc import behaviour_clone, dagger, imitation_loss
     from baselines.agents.demos import load_demos
     from baselines.agents.features import set_statistics
@@ -275,6 +297,7 @@ def _clone(model: Any, cfg: TrainConfig) -> dict[str, Any]:
         aggregate, rounds = dagger(
             model, demos, cfg.dagger_rounds, cfg.dagger_episodes, cfg.seed,
             epochs=max(cfg.bc_epochs // 3, 1), log_std=cfg.bc_log_std, pushes=_pushes(cfg),
+            deadline=deadline,
         )  # fmt: skip
         info.update(dagger_rounds=rounds.rounds, samples_after_dagger=len(aggregate))
     info["demo_pushes"] = demos.pushes.to_dict()

@@ -23,6 +23,7 @@ __all__ = [
     "METRICS",
     "aggregate_runs",
     "iqm",
+    "CURVE_AXES",
     "learning_curve",
     "performance_profile",
     "stratified_bootstrap_ci",
@@ -145,6 +146,8 @@ def aggregate_runs(
             "failed_seeds": sorted(f["spec"]["seed"] for f in bad),
             "eval_episodes": spec["eval_episodes"], "test_seed": spec["test_seed"],
             "timesteps": [r["timesteps"] for r in runs],
+            "time_budget_s": spec["recipe"].get("time_budget_s"),
+            "train_time_s": [r.get("train_time_s") for r in runs],
             "wall_time_s": [r["wall_time_s"] for r in runs],
             "steps_per_s": [r["steps_per_s"] for r in runs],
             "commands": [r["command"] for r in runs],
@@ -157,20 +160,35 @@ def aggregate_runs(
     return rows
 
 
+CURVE_AXES = ("timesteps", "train_time_s")
+"""What a learning curve can be drawn against: env steps, or seconds of training."""
+
+
 def learning_curve(
-    runs: Sequence[Mapping[str, Any]], key: str = "success_rate"
+    runs: Sequence[Mapping[str, Any]], key: str = "success_rate", axis: str = "timesteps"
 ) -> dict[str, list[Any]]:
-    """IQM and CI of ``key`` over seeds at each evaluation step all runs share."""
-    curves = [{int(e["timesteps"]): e.get(key) for e in r.get("curve", [])} for r in runs]
-    if not curves:
-        return {"timesteps": [], "iqm": [], "low": [], "high": []}
-    steps = sorted(set.intersection(*(set(c) for c in curves)))
-    out: dict[str, list[Any]] = {"timesteps": [], "iqm": [], "low": [], "high": []}
-    for step in steps:
-        stats = summarize_metric([[c[step] for c in curves]])
+    """IQM and CI of ``key`` over seeds at each evaluation every run has.
+
+    The k-th evaluations of all runs form the k-th point (runs of a grid evaluate on one
+    schedule: every N steps, or every N seconds of training under a time budget). Its
+    position on ``axis`` is the median over the runs, with their range in ``<axis>_range``:
+    under a time budget the steps of the k-th point differ from seed to seed, and without one
+    its seconds do. Runs without ``axis`` in their curve (older runs, for ``train_time_s``)
+    give an empty curve.
+    """
+    if axis not in CURVE_AXES:
+        raise ValueError(f"axis: expected one of {CURVE_AXES}, got {axis!r}")
+    out: dict[str, list[Any]] = {axis: [], f"{axis}_range": [], "iqm": [], "low": [], "high": []}
+    curves = [list(r.get("curve", [])) for r in runs]
+    if not curves or any(e.get(axis) is None for c in curves for e in c):
+        return out
+    for k in range(min(len(c) for c in curves)):
+        stats = summarize_metric([[c[k].get(key) for c in curves]])
         if stats["iqm"] is None:
             continue
-        out["timesteps"].append(step)
+        where = [float(c[k][axis]) for c in curves]
+        out[axis].append(float(np.median(where)))
+        out[f"{axis}_range"].append([min(where), max(where)])
         out["iqm"].append(stats["iqm"])
         out["low"].append(stats["iqm_ci"][0])
         out["high"].append(stats["iqm_ci"][1])

@@ -39,7 +39,20 @@ def _resolved_eval_freq(spec: RunSpec) -> int:
     if spec.recipe.algo == "ppo":  # PPO learns in whole rollouts of n_steps x n_envs
         rollout = int(hp.algo_kwargs.get("n_steps", 2048)) * hp.n_envs
         total = -(-total // rollout) * rollout
-    return max(total // 4, 1)
+    return max(total // CURVE_POINTS, 1)
+
+
+CURVE_POINTS = 4
+"""Learning-curve points per run when ``--eval-freq`` is 0: over its steps, or its budget."""
+
+
+def _curve_schedule(spec: RunSpec) -> dict[str, Any]:
+    """``eval_freq`` (steps) or, for a run with a time budget and ``--eval-freq 0``,
+    ``eval_every_s``: the same four points over the budget for every family."""
+    budget = spec.recipe.time_budget_s
+    if spec.eval_freq or budget is None:
+        return {"eval_freq": _resolved_eval_freq(spec)}
+    return {"eval_freq": 0, "eval_every_s": budget / CURVE_POINTS}
 
 
 def _score(model: Path, spec: RunSpec) -> dict[str, Any]:
@@ -71,7 +84,7 @@ def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
         with tempfile.TemporaryDirectory(prefix="sgc-bench-") as tmp:
             out = Path(tmp)
             options = spec.train_options(out="RUN_DIR")
-            options["eval_freq"] = _resolved_eval_freq(spec)
+            options.update(_curve_schedule(spec))
             command = train_command(options)
             options["out"] = str(out)
             result = train(TrainConfig(**options, command=command))
@@ -82,6 +95,9 @@ def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
             outcome.update(
                 status="finished", command=command, timesteps=result.timesteps,
                 train_wall_time_s=result.wall_time_s, steps_per_s=result.steps_per_s,
+                train_time_s=result.config["train_time_s"],
+                time_budget_s=spec.recipe.time_budget_s,
+                budget_spent=result.config["budget_spent"],
                 curve=result.evaluations, scores=scores,
                 wall_time_s=time.perf_counter() - started, files=_pack(out),
             )  # fmt: skip

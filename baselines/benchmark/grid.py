@@ -45,11 +45,13 @@ _PLACEHOLDER = re.compile(r"\{(env_id|seed)\}")
 #: ``sgc train`` options a recipe may set (TrainConfig fields the grid does not own).
 _OWNED = {
     "algo", "env_id", "seed", "out", "eval_freq", "eval_episodes", "eval_seed", "command",
-    "progress", "verbose", "env_kwargs", "hyperparams_dir", "timesteps",
+    "progress", "verbose", "env_kwargs", "hyperparams_dir", "timesteps", "time_budget_s",
+    "eval_every_s",
 }  # fmt: skip
-_RECIPE_FIELDS = {"name", "algo", "hyperparams", "timesteps", "env_kwargs", "train", "envs"}
+_RECIPE_FIELDS = {"name", "algo", "hyperparams", "timesteps", "time_budget_s", "env_kwargs",
+                  "train", "envs"}  # fmt: skip
 #: TrainConfig field -> ``sgc train`` flag, where the two are not spelled alike.
-_FLAGS = {"env_id": "--env", "hyperparams_dir": "--hyperparams"}
+_FLAGS = {"env_id": "--env", "hyperparams_dir": "--hyperparams", "time_budget_s": "--time-budget"}
 
 
 def _train_fields() -> dict[str, Any]:
@@ -86,6 +88,8 @@ class Recipe:
     train: Mapping[str, Any] = field(default_factory=dict)
     envs: tuple[str, ...] = ()
     """The env ids this recipe runs on (empty: every ``--env``); e.g. HER's goal-conditioned id."""
+    time_budget_s: float | None = None
+    """Seconds of training per run (``timesteps`` is then the upper bound); None: no budget."""
 
     def runs_on(self, env_id: str) -> bool:
         return not self.envs or env_id in self.envs
@@ -100,7 +104,7 @@ class Recipe:
             "name": self.name, "algo": self.algo, "hyperparams": self.hyperparams,
             "timesteps": self.timesteps, "env_kwargs": dict(self.env_kwargs),
             "train": dict(self.train), "envs": list(self.envs),
-            "demonstrations": self.demonstrations,
+            "demonstrations": self.demonstrations, "time_budget_s": self.time_budget_s,
         }  # fmt: skip
 
 
@@ -134,6 +138,7 @@ class RunSpec:
         return {
             "algo": self.recipe.algo, "env_id": self.env_id, "seed": self.seed,
             "timesteps": self.recipe.timesteps, "out": None if out is None else str(out),
+            "time_budget_s": self.recipe.time_budget_s,
             "eval_freq": self.eval_freq, "eval_episodes": self.curve_episodes,
             "eval_seed": self.eval_seed, "hyperparams_dir": self.recipe.hyperparams,
             "env_kwargs": dict(self.recipe.env_kwargs), **train,
@@ -185,6 +190,7 @@ def _check_name(name: Any, where: str) -> str:
 
 
 def _recipe(entry: Any, where: str) -> Recipe:
+    from baselines.agents.budget import check_time_budget
     from baselines.agents.train import ALGORITHMS
 
     if not isinstance(entry, Mapping):
@@ -199,6 +205,7 @@ def _recipe(entry: Any, where: str) -> Recipe:
     timesteps = entry.get("timesteps")
     if timesteps is not None and (not matches(timesteps, int) or timesteps < 0):
         raise ValueError(f"{where}: timesteps must be an integer >= 0, got {timesteps!r}")
+    budget = check_time_budget(entry.get("time_budget_s"), f"{where}: time_budget_s")
     env_kwargs = entry.get("env_kwargs") or {}
     train = entry.get("train") or {}
     if not isinstance(env_kwargs, Mapping) or not isinstance(train, Mapping):
@@ -221,7 +228,8 @@ def _recipe(entry: Any, where: str) -> Recipe:
 
     for env_id in envs:
         check_env_id(env_id, f"{where}: envs")
-    return Recipe(name, algo, hyperparams, timesteps, dict(env_kwargs), dict(train), tuple(envs))
+    return Recipe(name, algo, hyperparams, timesteps, dict(env_kwargs), dict(train), tuple(envs),
+                  budget)  # fmt: skip
 
 
 def load_recipes(path: str | Path) -> list[Recipe]:
@@ -253,6 +261,7 @@ def recipes_from_algos(
     hyperparams: str | None = None,
     env_kwargs: Mapping[str, Any] | None = None,
     timesteps: int | None = None,
+    time_budget_s: float | None = None,
 ) -> list[Recipe]:
     """One recipe per ``--algo``, named after it."""
     return [
@@ -262,6 +271,7 @@ def recipes_from_algos(
                 "hyperparams": hyperparams,
                 "env_kwargs": dict(env_kwargs or {}),
                 "timesteps": timesteps,
+                "time_budget_s": time_budget_s,
             },
             f"--algo {a}",
         )  # fmt: skip

@@ -1,7 +1,9 @@
 """The benchmark's outputs: ``leaderboard.json``, ``leaderboard.md`` and the plots.
 
-The markdown has one table per env id, one row per recipe: seeds, training steps and wall
-time per run, and for the final and the best model the goal-met rate and the main harness
+The markdown has one table per env id, one row per recipe: seeds, the wall-clock budget per
+run (``–``: none), the steps reached (median [min, max] over seeds: under a budget they vary),
+the seconds of training and the whole run's wall clock (scoring included), and for the final
+and the best model the goal-met rate and the main harness
 metrics as IQM [95 % CI] over seeds (the mean and every other metric are in the JSON).
 The command that reproduces the whole table heads the file.
 """
@@ -18,7 +20,12 @@ from typing import Any
 import numpy as np
 
 from baselines.atomic_files import write_atomic
-from baselines.benchmark.aggregate import CONFIDENCE, learning_curve, performance_profile
+from baselines.benchmark.aggregate import (
+    CONFIDENCE,
+    CURVE_AXES,
+    learning_curve,
+    performance_profile,
+)
 
 __all__ = ["format_ci", "markdown", "write_report"]
 
@@ -47,6 +54,17 @@ def _per_run(values: Sequence[float], fmt: str) -> str:
     return format(float(np.mean(values)), fmt) if values else "–"
 
 
+def _median_range(values: Sequence[float | None], fmt: str) -> str:
+    """``median [min, max]`` over seeds (``–`` when no run has the value)."""
+    known = [float(v) for v in values if v is not None]
+    if not known:
+        return "–"
+    median = float(np.median(known))
+    if len(known) == 1:
+        return format(median, fmt)
+    return f"{median:{fmt}} [{min(known):{fmt}}, {max(known):{fmt}}]"
+
+
 def _cell(row: Mapping[str, Any], model: str, key: str, fmt: str) -> str:
     metric, _, which = key.partition("|")
     return format_ci(row[model][metric], fmt, which or "iqm")
@@ -54,7 +72,8 @@ def _cell(row: Mapping[str, Any], model: str, key: str, fmt: str) -> str:
 
 def markdown(rows: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
     """The leaderboard in GitHub markdown (see the module docstring)."""
-    head = ["recipe", "algo", "demos", "seeds", "steps / run", "wall / run (s)",
+    head = ["recipe", "algo", "demos", "seeds", "budget / run (s)",
+            "steps reached: median [range]", "training (s): median [range]", "wall / run (s)",
             *(title for *_, title, _ in COLUMNS), "failed"]  # fmt: skip
     lines = [
         "# Benchmark leaderboard",
@@ -73,13 +92,24 @@ def markdown(rows: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
         for row in (r for r in rows if r["env_id"] == env_id):
             cells = [
                 row["recipe"], row["algo"], "yes" if row["demonstrations"] else "no",
-                str(len(row["seeds"])), _per_run(row["timesteps"], ",.0f"),
+                str(len(row["seeds"])), _budget(row.get("time_budget_s")),
+                _median_range(row["timesteps"], ",.0f"),
+                _median_range(row.get("train_time_s", []), ",.0f"),
                 _per_run(row["wall_time_s"], ",.0f"),
                 *(_cell(row, model, key, fmt) for model, key, _, fmt in COLUMNS),
                 str(len(row["failed_seeds"])),
             ]  # fmt: skip
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def _budget(seconds: float | None) -> str:
+    return "–" if seconds is None else format(seconds, "g")
+
+
+#: x-axis label of each learning-curve panel.
+_AXIS_LABELS = {"timesteps": "env steps (median over seeds)",
+                "train_time_s": "seconds of training (median over seeds)"}  # fmt: skip
 
 
 def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str, Any]],
@@ -92,7 +122,7 @@ def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str
     written = []
     taus = np.linspace(0.0, 1.0, 51)
     for env_id in sorted({r["env_id"] for r in rows}):
-        fig, (ax_p, ax_c) = plt.subplots(1, 2, figsize=(11, 4))
+        fig, (ax_p, *ax_curves) = plt.subplots(1, 3, figsize=(16, 4))
         for row in (r for r in rows if r["env_id"] == env_id and r["seeds"]):
             mine = [r for r in runs if r["spec"]["env_id"] == env_id
                     and r["spec"]["recipe"]["name"] == row["recipe"]]  # fmt: skip
@@ -101,17 +131,19 @@ def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str
             (line,) = ax_p.plot(prof["tau"], prof["fraction"], label=row["recipe"])
             ax_p.fill_between(prof["tau"], prof["low"], prof["high"], alpha=0.2,
                               color=line.get_color())  # fmt: skip
-            curve = learning_curve(mine)
-            if curve["timesteps"]:
-                ax_c.plot(curve["timesteps"], curve["iqm"], color=line.get_color(),
-                          marker="o", label=row["recipe"])  # fmt: skip
-                ax_c.fill_between(curve["timesteps"], curve["low"], curve["high"], alpha=0.2,
-                                  color=line.get_color())  # fmt: skip
+            for axis, ax_c in zip(CURVE_AXES, ax_curves, strict=True):
+                curve = learning_curve(mine, axis=axis)
+                if curve[axis]:
+                    ax_c.plot(curve[axis], curve["iqm"], color=line.get_color(), marker="o",
+                              label=row["recipe"])  # fmt: skip
+                    ax_c.fill_between(curve[axis], curve["low"], curve["high"], alpha=0.2,
+                                      color=line.get_color())  # fmt: skip
         ax_p.set(xlabel="goal-met rate tau (final model)", ylabel="fraction of runs > tau",
                  title=f"{env_id}: performance profile", ylim=(-0.02, 1.02))  # fmt: skip
-        ax_c.set(xlabel="env steps", ylabel="goal-met rate (IQM over seeds)",
-                 title=f"{env_id}: learning curves", ylim=(-0.02, 1.02))  # fmt: skip
-        for ax in (ax_p, ax_c):
+        for axis, ax_c in zip(CURVE_AXES, ax_curves, strict=True):
+            ax_c.set(xlabel=_AXIS_LABELS[axis], ylabel="goal-met rate (IQM over seeds)",
+                     title=f"{env_id}: learning curves", ylim=(-0.02, 1.02))  # fmt: skip
+        for ax in (ax_p, *ax_curves):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
         fig.tight_layout()
@@ -135,16 +167,13 @@ def write_report(
     atomically (two benchmarks on one folder: the last to finish wins, whole)."""
     root = Path(out)
     root.mkdir(parents=True, exist_ok=True)
-    curves = {
-        f"{r['env_id']}/{r['recipe']}": learning_curve(
-            [
-                x
-                for x in runs
-                if x["spec"]["env_id"] == r["env_id"] and x["spec"]["recipe"]["name"] == r["recipe"]
-            ]  # fmt: skip
-        )
-        for r in rows
-    }
+    curves = {}
+    for r in rows:
+        mine = [x for x in runs if x["spec"]["env_id"] == r["env_id"]
+                and x["spec"]["recipe"]["name"] == r["recipe"]]  # fmt: skip
+        curves[f"{r['env_id']}/{r['recipe']}"] = {
+            **learning_curve(mine), "wall_clock": learning_curve(mine, axis="train_time_s")
+        }
     data = {"meta": dict(meta), "rows": list(rows), "learning_curves": curves}
     json_path = write_atomic(root / "leaderboard.json",
                              json.dumps(data, indent=1, allow_nan=False) + "\n")  # fmt: skip

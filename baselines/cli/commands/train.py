@@ -18,6 +18,7 @@ from baselines.cli.checks import (
     known_env_id,
     nonneg_int,
     out_dir,
+    positive_float,
     positive_int,
     staged_output,
 )
@@ -37,6 +38,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "scores the clone without RL)",
     )  # fmt: skip
     parser.add_argument(
+        "--time-budget", type=positive_float, default=None, metavar="SECONDS",
+        help="stop training after SECONDS of wall clock (cloning included, curve evaluations "
+        "not); --timesteps stays the upper bound. The steps reached then depend on the machine",
+    )  # fmt: skip
+    parser.add_argument(
         "--out", type=out_dir, default=None,
         help="run folder: tb/, checkpoints/, models, config.json",
     )  # fmt: skip
@@ -44,6 +50,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--eval-freq", type=nonneg_int, default=0,
         help="env steps between harness evaluations (0: off)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--eval-every-s", type=positive_float, default=None, metavar="SECONDS",
+        help="seconds of training between harness evaluations (instead of --eval-freq)",
     )  # fmt: skip
     parser.add_argument(
         "--eval-episodes", type=positive_int, default=10, help="episodes per evaluation"
@@ -138,6 +148,7 @@ def run(args: argparse.Namespace) -> int:
         dagger_rounds=args.dagger_rounds, dagger_episodes=args.dagger_episodes,
         hyperparams_dir=args.hyperparams, env_kwargs=args.env_kwargs or {}, device=args.device,
         checkpoint_freq=args.checkpoint_freq, verbose=args.verbose, vec=args.vec,
+        time_budget_s=args.time_budget, eval_every_s=args.eval_every_s,
         command=shlex.join(["sgc", *sys.argv[1:]]), **pushes,
     )  # fmt: skip
     try:
@@ -150,6 +161,10 @@ def run(args: argparse.Namespace) -> int:
             result.model_path = args.out / "final_model.zip"
     except ValueError as exc:  # a bad input file (demos, hyperparameters) found while training
         raise UsageError(str(exc)) from None
+    if args.time_budget is not None:
+        spent = "spent" if result.config["budget_spent"] else "not spent"
+        print(f"time budget {args.time_budget:g} s {spent}: {result.timesteps} steps reached "
+              f"in {result.config['train_time_s']:.1f} s of training")  # fmt: skip
     print(
         f"{args.algo} on {args.env}: {result.timesteps} steps, learn {result.learn_time_s:.1f} s "
         f"({result.steps_per_s:.0f} steps/s), total {result.wall_time_s:.1f} s"
@@ -166,5 +181,6 @@ def run(args: argparse.Namespace) -> int:
             f"{args.eval_seed}{where}):\n{summary_line(last)}"
         )
     else:
-        print("not evaluated (add --eval-freq N to score the model with the harness)")
+        print("not evaluated (add --eval-freq N or --eval-every-s S to score the model with the "
+              "harness)")  # fmt: skip
     return 0
