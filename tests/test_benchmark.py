@@ -234,7 +234,7 @@ def _tiny_argv(out: Path, hp: Path, *extra: str) -> list[str]:
             "--out", str(out), *extra]  # fmt: skip
 
 
-_RUN_DEPENDENT = ("wall_time_s", "steps_per_s", "commands", "train_time_s")
+_RUN_DEPENDENT = ("wall_time_s", "steps_per_s", "commands", "train_time_s", "train_cpu_s")
 
 
 def _rows(out: Path) -> list[dict]:

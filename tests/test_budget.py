@@ -56,7 +56,7 @@ def test_the_budget_stops_a_short_learn(tmp_path: Path, tiny_hp: Path) -> None:
     assert config["budget_spent"] is True and config["time_budget_s"] == 1.0
     assert 0 < config["steps_reached"] == result.timesteps < 10_000_000
     # stopped at the budget: one env step plus one PPO update of 64 samples past it at most
-    assert 1.0 <= config["train_time_s"] < 5.0
+    assert 1.0 <= config["train_time_s"] < 5.0 and config["train_cpu_s"] > 0
     # curve points every 0.5 s of training, each with its steps and seconds
     times = [e["train_time_s"] for e in result.evaluations]
     assert len(times) >= 2 and times == sorted(times) and times[0] >= 0.6
@@ -113,6 +113,7 @@ def _fake_run(seed: int, steps: int, curve: list[tuple[int, float, float]]) -> d
     score = {"success_rate": curve[-1][2]}
     return {
         "spec": spec.to_dict(), "timesteps": steps, "train_time_s": 300.0 + seed,
+        "train_cpu_s": 270.0 + seed,
         "wall_time_s": 320.0 + seed, "steps_per_s": steps / 300, "command": "sgc train",
         "time_budget_s": 300, "scores": {"final": score, "best": score},
         "curve": [{"timesteps": n, "train_time_s": t, "success_rate": s} for n, t, s in curve],
@@ -147,10 +148,18 @@ def test_leaderboard_shows_budget_steps_reached_and_both_curves(tmp_path: Path) 
             "eval_seed": 10000}  # fmt: skip
     text = markdown(rows, meta)
     assert "budget / run (s)" in text and "steps reached: median [range]" in text
-    assert "| 300 | 7,000 [6,000, 9,000] | 301 [300, 302] |" in text
+    assert "| 300 | 7,000 [6,000, 9,000] | 301 [300, 302] | 0.90 |" in text
     written = write_report(rows, FAKE, meta, tmp_path)
     assert (tmp_path / "SGCRod-v0.png") in written
     data = json.loads((tmp_path / "leaderboard.json").read_text())
     curve = data["learning_curves"]["SGCRod-v0/sac"]
     assert curve["timesteps"] == [2500, 5000, 7000]
     assert curve["wall_clock"]["train_time_s"] == [76.0, 151.0, 301.0]
+
+
+def test_the_sweep_script_runs_every_budget_recipe() -> None:
+    text = (ROOT / "scripts" / "run_budget_rows.sh").read_text()
+    rows = {name for line in text.splitlines() if line.startswith("ROWS=")
+            for name in line.split("=", 1)[1].replace("$ROWS,", "").split(",")}  # fmt: skip
+    recipes = load_recipes(ROOT / "benchmarks" / "recipes.yml")
+    assert rows == {r.name for r in recipes if r.time_budget_s is not None}

@@ -94,6 +94,7 @@ class HarnessEvalCallback(BaseCallback):
         self._last_eval = 0
         self._next_eval_s = every_s
         self.eval_time_s = 0.0
+        self.eval_cpu_s = 0.0  # this process's CPU seconds in the evaluations
 
     def train_time_s(self) -> float:
         """Seconds of training so far, the evaluations taken off."""
@@ -115,12 +116,13 @@ class HarnessEvalCallback(BaseCallback):
         from baselines.evaluation import evaluate
 
         train_time = self.train_time_s()
-        started = time.perf_counter()
+        started, cpu_started = time.perf_counter(), time.process_time()
         result = evaluate(
             self._policy(), self.env_id, self.n_eval_episodes, self.seed,
             env_kwargs=self.env_kwargs or None,
         )  # fmt: skip
         self.eval_time_s += time.perf_counter() - started
+        self.eval_cpu_s += time.process_time() - cpu_started
         summary = dict(result.summary)
         flat = _scalar_items(summary)
         for key, value in flat.items():

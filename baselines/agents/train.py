@@ -189,6 +189,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         raise ValueError(f"hyperparameters of {cfg.algo} for {cfg.env_id}: {exc}") from None
     bc_info = None
     train_started = time.perf_counter()  # the budget's clock: cloning counts as training
+    cpu_started = time.process_time()  # this process only: SubprocVecEnv workers not counted
     if cfg.init == "bc":
         deadline = None if cfg.time_budget_s is None else train_started + cfg.time_budget_s
         bc_info = _clone(model, cfg, deadline)
@@ -225,9 +226,11 @@ def train(cfg: TrainConfig) -> TrainResult:
         )  # fmt: skip
     learn_time = time.perf_counter() - learn_started
     train_time = time.perf_counter() - train_started
+    train_cpu = time.process_time() - cpu_started
     if eval_cb is not None:
         learn_time -= eval_cb.eval_time_s
         train_time -= eval_cb.eval_time_s
+        train_cpu -= eval_cb.eval_cpu_s
     steps = int(model.num_timesteps)
     config = {
         "algo": cfg.algo,
@@ -260,6 +263,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     result.wall_time_s = time.perf_counter() - started
     config.update(
         wall_time_s=result.wall_time_s, learn_time_s=learn_time, train_time_s=train_time,
+        train_cpu_s=train_cpu,
         steps_per_s=result.steps_per_s, evaluations=result.evaluations,
     )  # fmt: skip
     if out is not None:

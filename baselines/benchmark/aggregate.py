@@ -148,6 +148,7 @@ def aggregate_runs(
             "timesteps": [r["timesteps"] for r in runs],
             "time_budget_s": spec["recipe"].get("time_budget_s"),
             "train_time_s": [r.get("train_time_s") for r in runs],
+            "train_cpu_s": [r.get("train_cpu_s") for r in runs],
             "wall_time_s": [r["wall_time_s"] for r in runs],
             "steps_per_s": [r["steps_per_s"] for r in runs],
             "commands": [r["command"] for r in runs],

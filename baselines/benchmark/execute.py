@@ -96,6 +96,7 @@ def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
                 status="finished", command=command, timesteps=result.timesteps,
                 train_wall_time_s=result.wall_time_s, steps_per_s=result.steps_per_s,
                 train_time_s=result.config["train_time_s"],
+                train_cpu_s=result.config["train_cpu_s"],
                 time_budget_s=spec.recipe.time_budget_s,
                 budget_spent=result.config["budget_spent"],
                 curve=result.evaluations, scores=scores,

@@ -2,9 +2,10 @@
 
 The markdown has one table per env id, one row per recipe: seeds, the wall-clock budget per
 run (``–``: none), the steps reached (median [min, max] over seeds: under a budget they vary),
-the seconds of training and the whole run's wall clock (scoring included), and for the final
-and the best model the goal-met rate and the main harness
-metrics as IQM [95 % CI] over seeds (the mean and every other metric are in the JSON).
+the seconds of training, their CPU share (CPU seconds of the run's process / wall seconds:
+below ~0.9 the run shared its core), the whole run's wall clock (scoring included), and for
+the final and the best model the goal-met rate and the main harness metrics as IQM [95 % CI]
+over seeds (the mean and every other metric are in the JSON).
 The command that reproduces the whole table heads the file.
 """
 
@@ -73,7 +74,8 @@ def _cell(row: Mapping[str, Any], model: str, key: str, fmt: str) -> str:
 def markdown(rows: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
     """The leaderboard in GitHub markdown (see the module docstring)."""
     head = ["recipe", "algo", "demos", "seeds", "budget / run (s)",
-            "steps reached: median [range]", "training (s): median [range]", "wall / run (s)",
+            "steps reached: median [range]", "training (s): median [range]", "CPU / wall",
+            "wall / run (s)",
             *(title for *_, title, _ in COLUMNS), "failed"]  # fmt: skip
     lines = [
         "# Benchmark leaderboard",
@@ -95,12 +97,21 @@ def markdown(rows: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
                 str(len(row["seeds"])), _budget(row.get("time_budget_s")),
                 _median_range(row["timesteps"], ",.0f"),
                 _median_range(row.get("train_time_s", []), ",.0f"),
+                _cpu_share(row),
                 _per_run(row["wall_time_s"], ",.0f"),
                 *(_cell(row, model, key, fmt) for model, key, _, fmt in COLUMNS),
                 str(len(row["failed_seeds"])),
             ]  # fmt: skip
             lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
+
+
+def _cpu_share(row: Mapping[str, Any]) -> str:
+    """Median over seeds of CPU seconds / wall seconds of training: below ~0.9 the run shared
+    its core, and a time budget then bought fewer steps than the machine gives alone."""
+    pairs = [(c, w) for c, w in zip(row.get("train_cpu_s", []), row.get("train_time_s", []),
+                                    strict=False) if c is not None and w]  # fmt: skip
+    return format(float(np.median([c / w for c, w in pairs])), ".2f") if pairs else "–"
 
 
 def _budget(seconds: float | None) -> str:

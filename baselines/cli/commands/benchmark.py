@@ -39,6 +39,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--env-kwargs", type=env_kwargs, default=None, help="JSON dict for gym.make (--algo)"
     )
     recipes.add_argument("--timesteps", type=int, default=None, help="steps per run (--algo)")
+    recipes.add_argument(
+        "--time-budget", type=float, default=None, metavar="SECONDS",
+        help="seconds of training per run (--algo); --timesteps is then the upper bound",
+    )  # fmt: skip
+    recipes.add_argument(
+        "--only", action="append", metavar="NAME",
+        help="run only these recipes of --recipes/--algo (repeat or comma-separate)",
+    )  # fmt: skip
     parser.add_argument("--env", action="append", required=True, metavar="ID",
                         help="env id; repeat or comma-separate")  # fmt: skip
     parser.add_argument("--seeds", type=int, default=3, help="training seeds per cell")
@@ -91,9 +99,16 @@ def _grid(args: argparse.Namespace) -> list[Any]:
     recipes = []
     if args.algo:
         recipes += recipes_from_algos(_split(args.algo), args.hyperparams, args.env_kwargs,
-                                      args.timesteps)  # fmt: skip
+                                      args.timesteps, args.time_budget)  # fmt: skip
     if args.recipes:
         recipes += load_recipes(args.recipes)
+    if args.only:
+        wanted = _split(args.only)
+        unknown = sorted(set(wanted) - {r.name for r in recipes})
+        if unknown:
+            raise ValueError(f"--only: no recipe named {unknown} (known: "
+                             f"{sorted(r.name for r in recipes)})")  # fmt: skip
+        recipes = [r for r in recipes if r.name in wanted]
     if args.seeds < 1 or args.first_seed < 0:
         raise ValueError(f"--seeds must be >= 1 and --first-seed >= 0, got {args.seeds}, "
                          f"{args.first_seed}")  # fmt: skip

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Issue 21's equal wall-clock rows (docs/agents.md, "Equal wall-clock budgets"): every budget
+# recipe of benchmarks/recipes.yml x 10 training seeds, one run per core (--workers 2 on the
+# 2-core machine; torch uses one thread per run). Resumable: rerun the same command and the
+# finished runs are skipped; with --report-only it runs nothing and writes the leaderboard
+# from the runs finished so far. Extra arguments go to `sgc benchmark`.
+#   scripts/run_budget_rows.sh                 # everything (about 4 h on 2 quiet cores)
+#   scripts/run_budget_rows.sh --report-only   # the leaderboard so far
+# Environment: OUT (runs/benchmark/budget), SEEDS (10), WORKERS (2), SGC (.venv/bin/sgc).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${OUT:-runs/benchmark/budget}
+SEEDS=${SEEDS:-10}
+WORKERS=${WORKERS:-2}
+SGC=${SGC:-.venv/bin/sgc}
+# keep in step with the budget recipes of benchmarks/recipes.yml (tests/test_budget.py checks)
+ROWS=ppo-alive64-300s,ppo-raw-300s,sac-300s,td3-300s,bc-dagger-300s
+ROWS=$ROWS,ppo-alive64-120s,ppo-raw-120s,sac-120s,td3-120s,her-time-120s,bc-dagger-120s
+if [[ " $* " != *" --report-only "* ]]; then
+    for env in SGCPoint-v0 SGCRod-v0; do  # the BC+DAgger rows' demonstrations (not timed)
+        demos=runs/benchmark-demos/${env}_100.npz
+        [[ -f $demos ]] || "$SGC" demos --env "$env" --episodes 100 --seed 0 --out "$demos"
+    done
+fi
+exec "$SGC" benchmark --recipes benchmarks/recipes.yml --only "$ROWS" \
+    --env SGCPoint-v0,SGCPointGoal-v0,SGCRod-v0 --seeds "$SEEDS" --eval-episodes 50 \
+    --workers "$WORKERS" --out "$OUT" "$@"
