@@ -163,3 +163,27 @@ def test_the_sweep_script_runs_every_budget_recipe() -> None:
             for name in line.split("=", 1)[1].replace("$ROWS,", "").split(",")}  # fmt: skip
     recipes = load_recipes(ROOT / "benchmarks" / "recipes.yml")
     assert rows == {r.name for r in recipes if r.time_budget_s is not None}
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac"])
+def test_a_budget_run_is_the_fixed_step_run_cut_where_the_budget_ended(
+    tiny_hp: Path, algo: str
+) -> None:
+    """The docs' determinism claim: the seed fixes the run up to the steps it learned from."""
+    import torch as th
+
+    from baselines.agents.train import TrainConfig, train
+
+    (tiny_hp / "sac.yml").write_text(yaml.safe_dump({"SGCPoint-v0": {
+        "n_timesteps": 64, "policy": "MlpPolicy", "n_envs": 2, "learning_starts": 20,
+        "batch_size": 16, "train_freq": 3, "policy_kwargs": "dict(net_arch=[8])",
+    }}))  # fmt: skip
+    common = {"algo": algo, "env_id": "SGCPoint-v0", "seed": 4, "hyperparams_dir": tiny_hp}
+    cut = train(TrainConfig(**common, timesteps=10_000_000, time_budget_s=0.5))
+    learned = cut.config["steps_learned"]
+    chunk = 64 if algo == "ppo" else 6  # a rollout of 2 x 32; train_freq 3 x 2 envs
+    assert learned % chunk == 0 and cut.timesteps - chunk <= learned <= cut.timesteps
+    again = train(TrainConfig(**common, timesteps=learned))
+    assert again.config["steps_learned"] == learned
+    for a, b in zip(cut.model.policy.parameters(), again.model.policy.parameters(), strict=True):
+        assert th.equal(a, b)

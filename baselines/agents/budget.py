@@ -15,8 +15,9 @@ import time
 from typing import Any
 
 from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 
-__all__ = ["TimeBudgetCallback", "check_time_budget"]
+__all__ = ["TimeBudgetCallback", "check_time_budget", "steps_learned"]
 
 
 def check_time_budget(value: Any, where: str = "time_budget_s") -> float | None:
@@ -29,6 +30,29 @@ def check_time_budget(value: Any, where: str = "time_budget_s") -> float | None:
     if not math.isfinite(seconds) or seconds <= 0:
         raise ValueError(f"{where}: expected a finite number of seconds > 0, got {value!r}")
     return seconds
+
+
+def steps_learned(model: Any, stopped: bool) -> int | None:
+    """The ``--timesteps`` of the fixed-step run with the same parameters as ``model``.
+
+    SB3 checks callbacks after each env step, and a stop there skips the update those steps
+    were collected for: PPO drops its unfinished rollout (it learns from whole rollouts of
+    ``n_steps x n_envs``), SAC/TD3 the gradient steps of the last ``train_freq`` chunk. So a
+    run the budget ``stopped`` took ``model.num_timesteps`` env steps but learned from fewer;
+    None where SB3 counts ``train_freq`` in episodes (no fixed-step equivalent).
+    """
+    steps = int(model.num_timesteps)
+    if not stopped:
+        return steps
+    n_envs = int(model.n_envs)
+    if isinstance(model, OnPolicyAlgorithm):  # whole rollouts
+        rollout = int(model.n_steps) * n_envs
+        return steps // rollout * rollout
+    freq = model.train_freq
+    if getattr(freq.unit, "value", "step") != "step":
+        return None
+    chunk = int(freq.frequency) * n_envs
+    return max(steps - n_envs, 0) // chunk * chunk
 
 
 class TimeBudgetCallback(BaseCallback):

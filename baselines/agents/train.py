@@ -145,7 +145,7 @@ def train(cfg: TrainConfig) -> TrainResult:
     from stable_baselines3.common.utils import set_random_seed
     from stable_baselines3.common.vec_env import VecNormalize
 
-    from baselines.agents.budget import TimeBudgetCallback
+    from baselines.agents.budget import TimeBudgetCallback, steps_learned
     from baselines.agents.callbacks import (
         FreezeActorCallback,
         HarnessEvalCallback,
@@ -239,6 +239,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         "seed": cfg.seed,
         "timesteps": total,
         "steps_reached": steps,
+        "steps_learned": steps_learned(model, budget_cb is not None and budget_cb.spent_out),
         "time_budget_s": cfg.time_budget_s,
         "budget_spent": budget_cb is not None and budget_cb.spent_out,
         "hyperparams": _jsonable(hp.raw),
