@@ -187,3 +187,17 @@ def test_a_budget_run_is_the_fixed_step_run_cut_where_the_budget_ended(
     assert again.config["steps_learned"] == learned
     for a, b in zip(cut.model.policy.parameters(), again.model.policy.parameters(), strict=True):
         assert th.equal(a, b)
+
+
+def test_the_budget_ends_dagger_rounds(tmp_path: Path) -> None:
+    from baselines.agents.demos import record_demos
+    from baselines.agents.train import TrainConfig, train
+
+    demos = record_demos("SGCPoint-v0", 1, seed=5).save(tmp_path / "demos.npz")
+    result = train(TrainConfig(
+        algo="ppo", env_id="SGCPoint-v0", timesteps=0, init="bc", demos=demos, bc_epochs=1,
+        dagger_rounds=1000, dagger_episodes=1, time_budget_s=1.0,
+    ))  # fmt: skip
+    assert result.config["budget_spent"] is True and result.timesteps == 0
+    assert 1 <= len(result.bc["dagger_rounds"]) < 1000  # type: ignore[index]
+    assert result.config["train_time_s"] >= 1.0

@@ -219,7 +219,8 @@ def train(cfg: TrainConfig) -> TrainResult:
         )
         callbacks.append(budget_cb)
     learn_started = time.perf_counter()
-    if total > 0 and not (budget_cb is not None and budget_cb.spent()):
+    spent_by_cloning = budget_cb is not None and budget_cb.spent()
+    if total > 0 and not spent_by_cloning:
         model.learn(
             total, callback=CallbackList(callbacks), progress_bar=cfg.progress,
             tb_log_name=f"{cfg.algo}_{cfg.env_id}_seed{cfg.seed}",
