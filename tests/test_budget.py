@@ -201,3 +201,19 @@ def test_the_budget_ends_dagger_rounds(tmp_path: Path) -> None:
     assert result.config["budget_spent"] is True and result.timesteps == 0
     assert 1 <= len(result.bc["dagger_rounds"]) < 1000  # type: ignore[index]
     assert result.config["train_time_s"] >= 1.0
+
+
+def test_a_benchmark_run_under_a_budget_puts_its_curve_by_seconds(tiny_hp: Path) -> None:
+    from baselines.benchmark.execute import execute_run
+
+    (recipe,) = recipes_from_algos(["ppo"], str(tiny_hp), timesteps=10_000_000,
+                                   time_budget_s=1.0)  # fmt: skip
+    (spec,) = build_grid([recipe], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+                         eval_episodes=1)  # fmt: skip
+    outcome = execute_run(spec.to_dict())
+    assert outcome["status"] == "finished", outcome.get("traceback")
+    assert "--time-budget 1.0" in outcome["command"] and "--eval-every-s 0.25" in outcome["command"]
+    assert outcome["time_budget_s"] == 1.0 and outcome["budget_spent"] is True
+    times = [e["train_time_s"] for e in outcome["curve"]]
+    # four points, 0.25 s of training apart (one is skipped if a pause of the machine jumps it)
+    assert 2 <= len(times) <= 4 and times[0] >= 0.25 and times[-1] >= 1.0
