@@ -118,9 +118,10 @@ def _budget(seconds: float | None) -> str:
     return "–" if seconds is None else format(seconds, "g")
 
 
-#: x-axis label of each learning-curve panel.
-_AXIS_LABELS = {"timesteps": "env steps (median over seeds)",
-                "train_time_s": "seconds of training (median over seeds)"}  # fmt: skip
+#: x-axis label and title of each learning-curve panel.
+_AXIS_LABELS = {"timesteps": ("env steps (median over seeds, bar: range)", "against steps"),
+                "train_time_s": ("seconds of training (median over seeds, bar: range)",
+                                 "against wall clock")}  # fmt: skip
 
 
 def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str, Any]],
@@ -149,11 +150,14 @@ def _plot_profiles(rows: Sequence[Mapping[str, Any]], runs: Sequence[Mapping[str
                               label=row["recipe"])  # fmt: skip
                     ax_c.fill_between(curve[axis], curve["low"], curve["high"], alpha=0.2,
                                       color=line.get_color())  # fmt: skip
+                    lo, hi = zip(*curve[f"{axis}_range"], strict=True)  # seeds' spread in x
+                    ax_c.hlines(curve["iqm"], lo, hi, color=line.get_color(), alpha=0.5)
         ax_p.set(xlabel="goal-met rate tau (final model)", ylabel="fraction of runs > tau",
                  title=f"{env_id}: performance profile", ylim=(-0.02, 1.02))  # fmt: skip
         for axis, ax_c in zip(CURVE_AXES, ax_curves, strict=True):
-            ax_c.set(xlabel=_AXIS_LABELS[axis], ylabel="goal-met rate (IQM over seeds)",
-                     title=f"{env_id}: learning curves", ylim=(-0.02, 1.02))  # fmt: skip
+            label, title = _AXIS_LABELS[axis]
+            ax_c.set(xlabel=label, ylabel="goal-met rate (IQM over seeds)",
+                     title=f"{env_id}: learning curves {title}", ylim=(-0.02, 1.02))  # fmt: skip
         for ax in (ax_p, *ax_curves):
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
