@@ -182,7 +182,7 @@ def test_a_budget_run_is_the_fixed_step_run_cut_where_the_budget_ended(
     cut = train(TrainConfig(**common, timesteps=10_000_000, time_budget_s=0.5))
     learned = cut.config["steps_learned"]
     chunk = 64 if algo == "ppo" else 6  # a rollout of 2 x 32; train_freq 3 x 2 envs
-    assert learned % chunk == 0 and cut.timesteps - chunk <= learned <= cut.timesteps
+    assert learned % chunk == 0 and cut.timesteps - chunk - 2 < learned < cut.timesteps
     again = train(TrainConfig(**common, timesteps=learned))
     assert again.config["steps_learned"] == learned
     for a, b in zip(cut.model.policy.parameters(), again.model.policy.parameters(), strict=True):
@@ -196,10 +196,12 @@ def test_the_budget_ends_dagger_rounds(tmp_path: Path) -> None:
     demos = record_demos("SGCPoint-v0", 1, seed=5).save(tmp_path / "demos.npz")
     result = train(TrainConfig(
         algo="ppo", env_id="SGCPoint-v0", timesteps=0, init="bc", demos=demos, bc_epochs=1,
-        dagger_rounds=1000, dagger_episodes=1, time_budget_s=1.0,
+        dagger_rounds=50, dagger_episodes=1, time_budget_s=1.0,
     ))  # fmt: skip
     assert result.config["budget_spent"] is True and result.timesteps == 0
-    assert 1 <= len(result.bc["dagger_rounds"]) < 1000  # type: ignore[index]
+    # 50 rounds would take several seconds: the budget ended them (maybe before the first,
+    # where cloning alone took the second on a loaded machine)
+    assert len(result.bc["dagger_rounds"]) < 50  # type: ignore[index]
     assert result.config["train_time_s"] >= 1.0
 
 

@@ -46,12 +46,14 @@ def steps_learned(model: Any, stopped: bool) -> int | None:
         return steps
     n_envs = int(model.n_envs)
     if isinstance(model, OnPolicyAlgorithm):  # whole rollouts
-        rollout = int(model.n_steps) * n_envs
-        return steps // rollout * rollout
-    freq = model.train_freq
-    if getattr(freq.unit, "value", "step") != "step":
-        return None
-    chunk = int(freq.frequency) * n_envs
+        chunk = int(model.n_steps) * n_envs
+    else:
+        freq = model.train_freq
+        if getattr(freq.unit, "value", "step") != "step":
+            return None
+        chunk = int(freq.frequency) * n_envs
+    # the stop came after the step that ends at ``steps``: its chunk was not learned from,
+    # even when that step completed it
     return max(steps - n_envs, 0) // chunk * chunk
 
 
