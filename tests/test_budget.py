@@ -219,3 +219,15 @@ def test_a_benchmark_run_under_a_budget_puts_its_curve_by_seconds(tiny_hp: Path)
     times = [e["train_time_s"] for e in outcome["curve"]]
     # four points, 0.25 s of training apart (one is skipped if a pause of the machine jumps it)
     assert 2 <= len(times) <= 4 and times[0] >= 0.25 and times[-1] >= 1.0
+
+
+def test_sgc_benchmark_names_a_bad_budget_or_recipe(
+    tmp_path: Path, tiny_hp: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    base = ["benchmark", "--algo", "ppo", "--hyperparams", str(tiny_hp), "--env", "SGCPoint-v0",
+            "--out", str(tmp_path / "out"), "--report-only", "--no-plots"]  # fmt: skip
+    assert cli.main([*base, "--time-budget", "0"]) == 2
+    assert "time_budget_s" in capsys.readouterr().err
+    assert cli.main([*base, "--only", "nope"]) == 2
+    assert "--only: no recipe named ['nope']" in capsys.readouterr().err
+    assert cli.main([*base, "--only", "ppo", "--time-budget", "5"]) == 0
