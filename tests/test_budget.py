@@ -45,6 +45,15 @@ def test_a_budget_is_a_finite_positive_number_of_seconds(bad: Any) -> None:
     assert check_time_budget(None) is None and check_time_budget(300) == 300.0
 
 
+def test_train_refuses_a_bad_budget_and_two_curve_schedules() -> None:
+    from baselines.agents.train import TrainConfig, train
+
+    with pytest.raises(ValueError, match="time_budget_s"):
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", time_budget_s=-1.0))
+    with pytest.raises(ValueError, match="not both"):
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", eval_freq=10, eval_every_s=1.0))
+
+
 def test_the_budget_stops_a_short_learn(tmp_path: Path, tiny_hp: Path) -> None:
     from baselines.agents.train import TrainConfig, train
 

@@ -112,6 +112,9 @@ def _validate(cfg: TrainConfig) -> None:
             raise ValueError("init: behaviour cloning needs a flat observation; not for her")
     check_time_budget(cfg.time_budget_s)
     check_time_budget(cfg.eval_every_s, "eval_every_s")
+    if cfg.eval_freq and cfg.eval_every_s is not None:
+        raise ValueError("eval_freq and eval_every_s: curve points by steps or by seconds, "
+                         "not both")  # fmt: skip
     if cfg.timesteps is not None and cfg.timesteps < 0:
         raise ValueError(f"timesteps must be >= 0, got {cfg.timesteps}")
     if cfg.eval_freq < 0 or cfg.checkpoint_freq < 0 or cfg.critic_warmup < 0:
