@@ -153,13 +153,14 @@ class SGCExpert:
         omega = f.vec(o, f.angular_velocity)
         # ``exact``: a goal is reached on the next tick, so the rotation must land exactly too
         # (the tracked point moves with it).
-        rotation_change, exact = None, False
+        rotation_change, exact, smooth_rotation = None, False, False
         track = f.orientation_track
         time_left = o[track.time_left] + o[track.time_left_residual]
         if o[track.flags] > 0.5 and time_left > 0.5 * period:
             phi = f.vec(o, track.deviation)
             smooth = self._smooth_course(index, "orientation", o, track)
-            if smooth is not None:
+            if smooth is not None:  # every tick lands exactly: see the module docstring
+                smooth_rotation = True
                 phi, time_left, rows, end_rate, rate = _toward_subgoal(
                     smooth, phi, time_left, period
                 )
@@ -198,7 +199,7 @@ class SGCExpert:
         return body_wrench(
             self.model, body, rotation, omega, f.vec(o, f.linear_velocity),
             f.vec(o, f.point_offset), displacement, rotation_change,
-            exact_rotation=exact, refine=self.refine,
+            exact_rotation=exact or smooth_rotation, refine=self.refine,
         )  # fmt: skip
 
     def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
