@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -36,7 +37,7 @@ from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 from sgc_env.envs.tracks import Track, compile_tracks
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import Profile, Rows, Vec3, _component_profiles, _frame_rows, _mul, _mul_t
-from sgc_env.paper.orientation import angular_acceleration, left_jacobian_inverse_apply
+from sgc_env.paper.orientation import _coefficients, left_jacobian_inverse_apply
 from sgc_env.scenario import Body, Scenario
 
 __all__ = ["LONGEST_SUBCOURSE", "TOLERANCE", "SmoothCourse", "SubGoals", "smooth_table"]
@@ -92,6 +93,28 @@ class SmoothCourse:
 SmoothTable = dict[tuple[int, str, tuple[float, ...]], SmoothCourse]
 
 
+def _cross(a: Vec3, b: Vec3) -> Vec3:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _world_rates(phi: Vec3, phi_dot: Vec3, phi_ddot: Vec3) -> tuple[Vec3, Vec3]:
+    """``omega = J_l phi'`` and ``omega' = J_l phi'' + (d/dt J_l) phi'`` in plain floats
+    (:func:`~sgc_env.paper.orientation.angular_acceleration`, without numpy's per-call cost)."""
+    a, b, da, db = _coefficients(math.hypot(*phi))
+    dot = phi[0] * phi_dot[0] + phi[1] * phi_dot[1] + phi[2] * phi_dot[2]
+    c1 = _cross(phi, phi_dot)
+    cc1 = _cross(phi, c1)
+    k2 = _cross(phi, phi_ddot)
+    kk2 = _cross(phi, k2)
+    dc = _cross(phi_dot, c1)
+    omega = tuple(phi_dot[i] + a * c1[i] + b * cc1[i] for i in range(3))
+    omega_dot = tuple(
+        phi_ddot[i] + a * k2[i] + b * kk2[i] + da * dot * c1[i] + db * dot * cc1[i] + b * dc[i]
+        for i in range(3)
+    )
+    return cast(Vec3, omega), cast(Vec3, omega_dot)
+
+
 class _Reference:
     """Reference samples at every control tick of a track: value, world rate, acceleration."""
 
@@ -112,10 +135,9 @@ class _Reference:
             rate = ref.phi_path.velocity(t)
             acc = ref.phi_path.acceleration(t)
             self.values = [tuple(q) for q in ref.orientation(t).tolist()]
-            self.rates = ref.angular_velocity(t)
-            self.accelerations = np.array(
-                [angular_acceleration(p, r, a) for p, r, a in zip(phi, rate, acc, strict=True)]
-            )
+            world = [_world_rates(*x) for x in zip(phi.tolist(), rate.tolist(), acc.tolist())]
+            self.rates = np.array([w for w, _ in world])
+            self.accelerations = np.array([a for _, a in world])
         else:
             arm = quat.rotate(body.orientation, track.points[0])
             start = np.add(body.position, arm)
@@ -163,7 +185,7 @@ def _gap(
         if ref.orientation:
             d = _mul_t(rows, (s[0][0], s[1][0], s[2][0]))
             v = _mul_t(rows, (s[0][1], s[1][1], s[2][1]))
-            acc = tuple(angular_acceleration(d, v, acc).tolist())
+            acc = _world_rates(d, v, acc)[1]
         gap = max(gap, math.dist(acc, ref.accelerations[tick]))
     return gap, rows, profiles
 
