@@ -219,7 +219,8 @@ class SGCExpert:
         if course is None:
             rule = self.end_rule or self.model.end_rule
             matched = self._matched(key) if rule == "matched" and key[12] <= 0.5 else None
-            course = _course_constants(key, "tangent" if rule == "matched" else rule, matched)
+            fallback = "tangent" if rule in ("matched", "smooth") else rule
+            course = _course_constants(key, fallback, matched)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
