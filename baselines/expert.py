@@ -22,8 +22,8 @@ import numpy as np
 from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
 from baselines.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
-from baselines.smooth_table import SmoothCourse, SmoothTable, smooth_table
 from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.smooth_table import SmoothCourse, SmoothTable, smooth_table
 from baselines.vector import base_env
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import course_end_velocity, next_deviation

@@ -130,7 +130,8 @@ class EpisodeExpert:
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
                 model = episode_model(self.env, i)
-                scenario = scenario_of(self.env, i) if self.end_rule in ("matched", "smooth") else None
+                whole = self.end_rule in ("matched", "smooth")  # rules that read whole tracks
+                scenario = scenario_of(self.env, i) if whole else None
                 self._experts[i] = SGCExpert(model=model, end_rule=self.end_rule, scenario=scenario)
             return self._experts[i].action(row)
 

@@ -54,6 +54,7 @@ BEND = 0.5
 velocity: beyond it the course bends too much for an SGC course re-solved from a measured
 state mid-way (measured: a 1.1 rad/s turn reversing in 8 ticks gave 4x minimum jerk's kink)."""
 
+_NO_COURSE = cast(tuple[Profile, Profile, Profile], ())
 _IDENTITY: Rows = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
@@ -135,7 +136,10 @@ class _Reference:
             rate = ref.phi_path.velocity(t)
             acc = ref.phi_path.acceleration(t)
             self.values = [tuple(q) for q in ref.orientation(t).tolist()]
-            world = [_world_rates(*x) for x in zip(phi.tolist(), rate.tolist(), acc.tolist())]
+            world = [
+                _world_rates(*x)
+                for x in zip(phi.tolist(), rate.tolist(), acc.tolist(), strict=True)
+            ]
             self.rates = np.array([w for w, _ in world])
             self.accelerations = np.array([a for _, a in world])
         else:
@@ -169,7 +173,7 @@ def _gap(
     d0 = ref.deviation(a, b)
     bend = math.dist(ref.rates[a], ref.rates[b]) * (b - a) * dt
     if b - a > 1 and bend > BEND * math.hypot(*d0):
-        return math.inf, _IDENTITY, ()
+        return math.inf, _IDENTITY, _NO_COURSE
     out = _frame_rows(d0, None if c is None else ref.deviation(b, c))
     rows = _IDENTITY if out is None else out[0]
     v0 = ref.rate(a)
