@@ -3,7 +3,8 @@
 Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tangent rule),
 ``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``expert-matched`` (SGC with
 end velocities solved over whole tracks so accelerations match, :mod:`sgc_env.paper.matched`),
-``dynamic-constraints``,
+``expert-smooth`` (SGC sub-courses between transient sub-goals on the minimum-jerk reference,
+:mod:`baselines.smooth_table`), ``dynamic-constraints``,
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
 :mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
