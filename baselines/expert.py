@@ -238,22 +238,31 @@ class SGCExpert:
         if (self.end_rule or self.model.end_rule) != "smooth":
             return None
         lookup = (index, name, course_key(o[track.course : track.course + 8]))
-        if self._smooth is None or (lookup not in self._smooth and self._env is not None):
-            scenario = self._scenario if self._env is None else base_env(self._env).scenario
-            if scenario is not None and (self._smooth is None or scenario is not self._scenario):
-                self._scenario = scenario
-                self._smooth = smooth_table(scenario)
+        table = self._smooth
+        scenario = self._new_scenario(table is not None, table is not None and lookup in table)
+        if scenario is not None:
+            self._smooth = smooth_table(scenario)
         return None if self._smooth is None else self._smooth.get(lookup)
+
+    def _new_scenario(self, loaded: bool, found: bool) -> Any | None:
+        """The episode's scenario when a rule's table must be (re)built from it: none is
+        loaded yet, or a course is not found and the env's scenario has changed; else None."""
+        if loaded and (found or self._env is None):
+            return None
+        scenario = self._scenario if self._env is None else base_env(self._env).scenario
+        if scenario is None or (loaded and scenario is self._scenario):
+            return None
+        self._scenario = scenario
+        return scenario
 
     def _matched(self, key: tuple[float, ...]) -> tuple[tuple[float, float, float], bool] | None:
         """The matched end velocity of an interior course and whether its track was solved,
         or None for an unknown course."""
         lookup = course_key(key)
-        if self._table is None or (lookup not in self._table and self._env is not None):
-            scenario = self._scenario if self._env is None else base_env(self._env).scenario
-            if scenario is not None and (self._table is None or scenario is not self._scenario):
-                self._scenario = scenario
-                self._table = matched_table(scenario)
+        table = self._table
+        scenario = self._new_scenario(table is not None, table is not None and lookup in table)
+        if scenario is not None:
+            self._table = matched_table(scenario)
         return None if self._table is None else self._table.get(lookup)
 
 

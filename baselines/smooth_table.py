@@ -32,7 +32,7 @@ from typing import cast
 
 import numpy as np
 
-from baselines.matched_table import course_key
+from baselines.matched_table import course_key, course_row
 from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 from sgc_env.envs.tracks import Track, compile_tracks
 from sgc_env.paper import quaternion as quat
@@ -222,11 +222,6 @@ def _subgoals(ref: _Reference, goal_ticks: np.ndarray, dt: float) -> SubGoals:
     )  # fmt: skip
 
 
-def _track_rows(track: Track, k: int) -> list[float]:
-    return [*track.course_start[k], track.durations[k], *track.next_start[k],
-            track.next_duration[k]]  # fmt: skip
-
-
 def smooth_table(scenario: Scenario) -> SmoothTable:
     """(body, ``"position"`` or ``"orientation"``, course key) -> :class:`SmoothCourse`, for
     every course of every track of a resolved scenario."""
@@ -246,5 +241,5 @@ def smooth_table(scenario: Scenario) -> SmoothTable:
                 real = not (orientation and track.via.size and track.via[k])
                 target = tuple(float(x) for x in track.targets[k])
                 entry = SmoothCourse(subgoals, int(track.ticks[k]), target, real)
-                table[(index, name, course_key(_track_rows(track, k)))] = entry
+                table[(index, name, course_key(course_row(track, k)))] = entry
     return table

@@ -12,7 +12,7 @@ import pytest
 import sgc_env  # noqa: F401  (registers the ids)
 from baselines.evaluation import evaluate
 from baselines.expert import SGCExpert
-from baselines.matched_table import course_key
+from baselines.matched_table import course_key, course_row
 from baselines.smooth_table import LONGEST_SUBCOURSE, smooth_table
 from sgc_env.paper import quaternion as quat
 
@@ -34,9 +34,7 @@ def test_every_real_goal_is_a_sub_goal_on_the_reference():
 
     for index, tracks in enumerate(compile_tracks(scenario)):
         for name, track in (("position", tracks.position), ("orientation", tracks.orientation)):
-            key = [*track.course_start[0], track.durations[0], *track.next_start[0],
-                   track.next_duration[0]]  # fmt: skip
-            sub = table[(index, name, course_key(key))].subgoals
+            sub = table[(index, name, course_key(course_row(track, 0)))].subgoals
             ticks = np.array(sub.ticks)
             assert np.all(np.diff(ticks) >= 1) and ticks[0] >= 1
             assert np.diff(np.concatenate(([0], ticks))).max() <= LONGEST_SUBCOURSE
