@@ -59,15 +59,17 @@ class SGCExpert:
         scenario: Any | None = None,
     ) -> None:
         """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
-        :mod:`sgc_env.paper.frames`), or ``"matched"`` (:mod:`sgc_env.paper.matched`:
-        accelerations matched over whole tracks); None follows the scenario
-        (``model.end_rule``). ``"matched"`` reads the episode's scenario (``scenario``, else
-        ``env``'s current one, re-read when a course is not found) and looks every course up
-        in its solved table (:mod:`baselines.matched_table`); a course it does not know (a
-        state of another scenario) ends by the tangent rule.
+        :mod:`sgc_env.paper.frames`), ``"matched"`` (:mod:`sgc_env.paper.matched`:
+        accelerations matched over whole tracks) or ``"smooth"`` (SGC sub-courses between
+        transient sub-goals on the minimum-jerk reference, :mod:`baselines.smooth_table`);
+        None follows the scenario (``model.end_rule``). ``"matched"`` and ``"smooth"`` read the
+        episode's scenario (``scenario``, else ``env``'s current one, re-read when a course is
+        not found) and look every course up in their table (:mod:`baselines.matched_table`,
+        :mod:`baselines.smooth_table`); a course they do not know (a state of another
+        scenario) ends by the tangent rule.
 
         ``refine``: give the torque between goals its correction step on the simulated
-        rotation (goal ticks always get the exact Newton).
+        rotation (goal ticks, and every tick under ``"smooth"``, get the exact Newton).
 
         Measured on SGCRod-v0 and the three-rod demo: the closed-form first guess alone
         misses the planned rotation by ~1e-6 rad per tick (median; up to 1e-4 on a thin rod's
@@ -159,7 +161,7 @@ class SGCExpert:
         if o[track.flags] > 0.5 and time_left > 0.5 * period:
             phi = f.vec(o, track.deviation)
             smooth = self._smooth_course(index, "orientation", o, track)
-            if smooth is not None:  # every tick lands exactly: see the module docstring
+            if smooth is not None:  # every tick lands exactly (baselines.smooth_table)
                 smooth_rotation = True
                 phi, time_left, rows, end_rate, rate = _toward_subgoal(
                     smooth, phi, time_left, period
