@@ -13,6 +13,7 @@ runs inside ``evaluate_policy``, vector envs and imitation tools.
 
 from __future__ import annotations
 
+import bisect
 import math
 from typing import Any
 
@@ -22,6 +23,7 @@ from baselines.actuation import body_wrench
 from baselines.env_model import BodyModel, EnvModel
 from baselines.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
 from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.smooth_table import SmoothCourse, SmoothTable, smooth_table
 from baselines.vector import base_env
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import course_end_velocity, next_deviation
@@ -57,15 +59,17 @@ class SGCExpert:
         scenario: Any | None = None,
     ) -> None:
         """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
-        :mod:`sgc_env.paper.frames`), or ``"matched"`` (:mod:`sgc_env.paper.matched`:
-        accelerations matched over whole tracks); None follows the scenario
-        (``model.end_rule``). ``"matched"`` reads the episode's scenario (``scenario``, else
-        ``env``'s current one, re-read when a course is not found) and looks every course up
-        in its solved table (:mod:`baselines.matched_table`); a course it does not know (a
-        state of another scenario) ends by the tangent rule.
+        :mod:`sgc_env.paper.frames`), ``"matched"`` (:mod:`sgc_env.paper.matched`:
+        accelerations matched over whole tracks) or ``"smooth"`` (SGC sub-courses between
+        transient sub-goals on the minimum-jerk reference, :mod:`baselines.smooth_table`);
+        None follows the scenario (``model.end_rule``). ``"matched"`` and ``"smooth"`` read the
+        episode's scenario (``scenario``, else ``env``'s current one, re-read when a course is
+        not found) and look every course up in their table (:mod:`baselines.matched_table`,
+        :mod:`baselines.smooth_table`); a course they do not know (a state of another
+        scenario) ends by the tangent rule.
 
         ``refine``: give the torque between goals its correction step on the simulated
-        rotation (goal ticks always get the exact Newton).
+        rotation (goal ticks, and every tick under ``"smooth"``, get the exact Newton).
 
         Measured on SGCRod-v0 and the three-rod demo: the closed-form first guess alone
         misses the planned rotation by ~1e-6 rad per tick (median; up to 1e-4 on a thin rod's
@@ -81,8 +85,8 @@ class SGCExpert:
             model = EnvModel.from_env(env)
         if end_rule is not None and end_rule not in EXPERT_RULES:
             raise ValueError(f"end_rule must be one of {list(EXPERT_RULES)}, got {end_rule!r}")
-        if end_rule == "matched" and env is None and scenario is None:
-            raise ValueError("end_rule='matched' needs the env or the episode's scenario")
+        if end_rule in ("matched", "smooth") and env is None and scenario is None:
+            raise ValueError(f"end_rule={end_rule!r} needs the env or the episode's scenario")
         self.model = model
         self._env = env
         self._scenario = scenario
@@ -90,7 +94,8 @@ class SGCExpert:
         self.refine = refine
         self.end_rule = end_rule
         self._fields_of: EnvModel | None = None  # the model ``_bodies`` was built for
-        self._bodies: tuple[tuple[BodyFields, BodyModel], ...] = ()
+        self._bodies: tuple[tuple[int, BodyFields, BodyModel], ...] = ()
+        self._smooth: SmoothTable | None = None
         self._courses: dict[tuple[float, ...], tuple[tuple, tuple, bool, bool]] = {}
 
     def predict(
@@ -127,7 +132,7 @@ class SGCExpert:
             )
         if self._fields_of is not model:  # built lazily: ``model`` may be reassigned
             self._bodies = tuple(
-                (BodyFields(model.layout, i), body) for i, body in enumerate(model.bodies)
+                (i, BodyFields(model.layout, i), body) for i, body in enumerate(model.bodies)
             )
             self._fields_of = model
             self._courses.clear()  # a new model may bring another end rule
@@ -135,43 +140,59 @@ class SGCExpert:
         if not math.isfinite(sum(values)):  # NaN or inf anywhere makes the sum non-finite
             raise ValueError("observation contains non-finite values")
         forces, torques, rotations = [], [], []
-        for fields, body in self._bodies:
+        for index, fields, body in self._bodies:
             rotation = fields.rotation(values)
-            force, torque = self._body_wrench(fields, body, values, rotation)
+            force, torque = self._body_wrench(index, fields, body, values, rotation)
             forces.append(force)
             torques.append(torque)
             rotations.append(rotation)
         return model.action_from_wrenches(forces, torques, rotations)
 
     def _body_wrench(
-        self, f: BodyFields, body: BodyModel, o: list[float], rotation: tuple
+        self, index: int, f: BodyFields, body: BodyModel, o: list[float], rotation: tuple
     ) -> tuple[tuple, tuple]:
         period = self.model.control_dt
         omega = f.vec(o, f.angular_velocity)
         # ``exact``: a goal is reached on the next tick, so the rotation must land exactly too
         # (the tracked point moves with it).
-        rotation_change, exact = None, False
+        rotation_change, exact, smooth_rotation = None, False, False
         track = f.orientation_track
         time_left = o[track.time_left] + o[track.time_left_residual]
         if o[track.flags] > 0.5 and time_left > 0.5 * period:
             phi = f.vec(o, track.deviation)
+            smooth = self._smooth_course(index, "orientation", o, track)
+            if smooth is not None:  # every tick lands exactly (baselines.smooth_table)
+                smooth_rotation = True
+                phi, time_left, rows, end_rate, rate = _toward_subgoal(
+                    smooth, phi, time_left, period
+                )
             if time_left <= period * (1.0 + GOAL_TICK_SLACK):
                 exact, phi_next = True, _ZERO3
             else:
-                phi_dot = left_jacobian_inverse_apply(phi, omega)
-                phi_next = self._next_deviation(o, track, phi, phi_dot, time_left, period)
+                if smooth is None:
+                    phi_dot = left_jacobian_inverse_apply(phi, omega)
+                    phi_next = self._next_deviation(o, track, phi, phi_dot, time_left, period)
+                else:
+                    phi_next = next_deviation(rows, phi, rate, time_left, end_rate, period)
             rotation_change = quat.mul(quat.exp(phi_next), quat.exp((-phi[0], -phi[1], -phi[2])))
         displacement = None
         track = f.position_track
         time_left = o[track.time_left] + o[track.time_left_residual]
         if o[track.flags] > 0.5 and time_left > 0.5 * period:
             deviation = f.vec(o, track.deviation)
+            smooth = self._smooth_course(index, "position", o, track)
+            if smooth is not None:
+                deviation, time_left, rows, end_rate, rate = _toward_subgoal(
+                    smooth, deviation, time_left, period
+                )
             if time_left <= period * (1.0 + GOAL_TICK_SLACK):
                 exact, deviation_next = True, _ZERO3
-            else:
+            elif smooth is None:
                 deviation_next = self._next_deviation(
                     o, track, deviation, f.vec(o, f.point_velocity), time_left, period
                 )
+            else:
+                deviation_next = next_deviation(rows, deviation, rate, time_left, end_rate, period)
             displacement = (
                 deviation_next[0] - deviation[0],
                 deviation_next[1] - deviation[1],
@@ -180,7 +201,7 @@ class SGCExpert:
         return body_wrench(
             self.model, body, rotation, omega, f.vec(o, f.linear_velocity),
             f.vec(o, f.point_offset), displacement, rotation_change,
-            exact_rotation=exact, refine=self.refine,
+            exact_rotation=exact or smooth_rotation, refine=self.refine,
         )  # fmt: skip
 
     def _next_deviation(self, o, track: TrackFields, deviation, rate, time_left, period):
@@ -200,7 +221,8 @@ class SGCExpert:
         if course is None:
             rule = self.end_rule or self.model.end_rule
             matched = self._matched(key) if rule == "matched" and key[12] <= 0.5 else None
-            course = _course_constants(key, "tangent" if rule == "matched" else rule, matched)
+            fallback = "tangent" if rule in ("matched", "smooth") else rule
+            course = _course_constants(key, fallback, matched)
             if len(self._courses) >= _CACHE_SIZE:
                 self._courses.clear()
             self._courses[key] = course
@@ -210,16 +232,65 @@ class SGCExpert:
             rows, deviation, rate, time_left, end_velocity, period, smooth_rest, lag
         )
 
+    def _smooth_course(
+        self, index: int, name: str, o: list[float], track: TrackFields
+    ) -> SmoothCourse | None:
+        """The current course's sub-goals under the smooth rule; None under another rule or
+        for a course of another scenario (it then ends by the tangent rule)."""
+        if (self.end_rule or self.model.end_rule) != "smooth":
+            return None
+        lookup = (index, name, course_key(o[track.course : track.course + 8]))
+        table = self._smooth
+        scenario = self._new_scenario(table is not None, table is not None and lookup in table)
+        if scenario is not None:
+            self._smooth = smooth_table(scenario)
+        return None if self._smooth is None else self._smooth.get(lookup)
+
+    def _new_scenario(self, loaded: bool, found: bool) -> Any | None:
+        """The episode's scenario when a rule's table must be (re)built from it: none is
+        loaded yet, or a course is not found and the env's scenario has changed; else None."""
+        if loaded and (found or self._env is None):
+            return None
+        scenario = self._scenario if self._env is None else base_env(self._env).scenario
+        if scenario is None or (loaded and scenario is self._scenario):
+            return None
+        self._scenario = scenario
+        return scenario
+
     def _matched(self, key: tuple[float, ...]) -> tuple[tuple[float, float, float], bool] | None:
         """The matched end velocity of an interior course and whether its track was solved,
         or None for an unknown course."""
         lookup = course_key(key)
-        if self._table is None or (lookup not in self._table and self._env is not None):
-            scenario = self._scenario if self._env is None else base_env(self._env).scenario
-            if scenario is not None and (self._table is None or scenario is not self._scenario):
-                self._scenario = scenario
-                self._table = matched_table(scenario)
+        table = self._table
+        scenario = self._new_scenario(table is not None, table is not None and lookup in table)
+        if scenario is not None:
+            self._table = matched_table(scenario)
         return None if self._table is None else self._table.get(lookup)
+
+
+def _toward_subgoal(
+    course: SmoothCourse, deviation: tuple, time_left: float, period: float
+) -> tuple[tuple, float, tuple, tuple, tuple]:
+    """The deviation from the next sub-goal, the time to it, the frame of its sub-course, the
+    reference's velocity there and the sub-course's planned rate now
+    (:mod:`baselines.smooth_table`). Deviations are measured from the reference's sub-goal
+    (for a rotation its principal log: the env's unwrapped deviation can take the other way
+    round than the reference), but on the tick that reaches a real goal the env's deviation
+    is kept, so the goal is met exactly."""
+    sub = course.subgoals
+    now = course.end_tick - round(time_left / period)
+    j = min(bisect.bisect_right(sub.ticks, now), len(sub.ticks) - 1)
+    knot = sub.ticks[j]
+    time_to = time_left - (course.end_tick - knot) * period
+    if not (knot == course.end_tick and course.real and time_to <= period * (1 + GOAL_TICK_SLACK)):
+        value, target = sub.values[j], course.target
+        if sub.orientation:
+            here = quat.mul(quat.exp(deviation), target)
+            deviation = quat.log(quat.mul_conjugate(here, value))
+        else:
+            deviation = tuple(d + t - v for d, t, v in zip(deviation, target, value, strict=True))
+    rate = sub.planned_rate(j, knot - time_to / period, period)
+    return deviation, time_to, sub.rows[j], sub.velocities[j], rate
 
 
 def substep_lag(period: float, substeps: int) -> float:

@@ -19,11 +19,12 @@ from sgc_env.envs.tracks import Track, compile_tracks
 from sgc_env.paper import quaternion as quat
 from sgc_env.scenario import Scenario
 
-__all__ = ["EXPERT_RULES", "course_key", "matched_table"]
+__all__ = ["EXPERT_RULES", "course_key", "course_row", "matched_table"]
 
-EXPERT_RULES: tuple[str, ...] = ("tangent", "paper", "matched")
+EXPERT_RULES: tuple[str, ...] = ("tangent", "paper", "matched", "smooth")
 """End rules the expert plays: the scenario's two (:data:`sgc_env.paper.end_rules.END_RULES`)
-and ``"matched"``, which needs the scenario's whole tracks."""
+and ``"matched"`` and ``"smooth"`` (:mod:`baselines.smooth_table`), which need the scenario's
+whole tracks."""
 
 MatchedTable = dict[tuple[float, ...], tuple[tuple[float, float, float], bool]]
 """Course key -> (end velocity, whether it was solved rather than the tangent rule's)."""
@@ -34,7 +35,9 @@ def course_key(values: Sequence[float]) -> tuple[float, ...]:
     return tuple(np.asarray(values[:8], np.float32).tolist())
 
 
-def _track_rows(track: Track, k: int) -> list[float]:
+def course_row(track: Track, k: int) -> list[float]:
+    """Course ``k``'s first 8 observation entries as the env compiles them (see
+    :func:`course_key`)."""
     return [*track.course_start[k], track.durations[k], *track.next_start[k],
             track.next_duration[k]]  # fmt: skip
 
@@ -62,5 +65,5 @@ def matched_table(scenario: Scenario) -> MatchedTable:
             for k in range(track.size - 1):
                 v = ends.velocities[k]
                 velocity = (float(v[0]), float(v[1]), float(v[2]))
-                table[course_key(_track_rows(track, k))] = (velocity, ends.solved)
+                table[course_key(course_row(track, k))] = (velocity, ends.solved)
     return table

@@ -3,7 +3,8 @@
 Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tangent rule),
 ``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``expert-matched`` (SGC with
 end velocities solved over whole tracks so accelerations match, :mod:`sgc_env.paper.matched`),
-``dynamic-constraints``,
+``expert-smooth`` (SGC sub-courses between transient sub-goals on the minimum-jerk reference,
+:mod:`baselines.smooth_table`), ``dynamic-constraints``,
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
 :mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
@@ -55,7 +56,8 @@ __all__ = [
 ]
 
 BUILTIN_POLICIES: tuple[str, ...] = (
-    "expert", "expert-paper", "expert-matched", "dynamic-constraints", "minimum-jerk", "random"
+    "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
+    "minimum-jerk", "random",
 )  # fmt: skip
 _TRUST_MODELS: contextvars.ContextVar[bool] = contextvars.ContextVar("trust_models", default=False)
 
@@ -129,7 +131,8 @@ class EpisodeExpert:
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
                 model = episode_model(self.env, i)
-                scenario = scenario_of(self.env, i) if self.end_rule == "matched" else None
+                whole = self.end_rule in ("matched", "smooth")  # rules that read whole tracks
+                scenario = scenario_of(self.env, i) if whole else None
                 self._experts[i] = SGCExpert(model=model, end_rule=self.end_rule, scenario=scenario)
             return self._experts[i].action(row)
 
@@ -253,7 +256,10 @@ def make_policy(
     spec = resolve_policy_spec(spec)
     if spec == "random":
         return RandomPolicy(_spaces_env(env).action_space, seed)
-    if spec in ("expert", "expert-paper", "expert-matched", "dynamic-constraints", "minimum-jerk"):
+    if spec in (
+        "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
+        "minimum-jerk",
+    ):  # fmt: skip
         _needs_flat_observation(env, spec)
         if spec == "expert":
             return EpisodeExpert(env)
@@ -261,6 +267,8 @@ def make_policy(
             return EpisodeExpert(env, end_rule="paper")
         if spec == "expert-matched":
             return EpisodeExpert(env, end_rule="matched")
+        if spec == "expert-smooth":
+            return EpisodeExpert(env, end_rule="smooth")
         if spec == "dynamic-constraints":
             return DynamicConstraintsController(env)
         return MinimumJerkController(env)

@@ -55,7 +55,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--episodes", type=int, default=5, help="random scenes (default 5)")
     parser.add_argument("--seed", type=int, default=EVAL_SEED)
-    parser.add_argument("--policy", default="expert", help="expert, expert-paper or expert-matched")
+    parser.add_argument(
+        "--policy", default="expert",
+        help="expert, expert-paper, expert-matched or expert-smooth",
+    )  # fmt: skip
     parser.add_argument("--limit", type=float, default=2.0, help="largest ratio that passes")
     args = parser.parse_args(argv)
     rows = compare("SGCThreeRods-v1", 1, 0, args.policy)

@@ -96,7 +96,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.normalization", "baselines.model_files"),
     ("baselines.env_model",),
     ("baselines.actuation",),
-    ("baselines.matched_table",),
+    ("baselines.matched_table", "baselines.smooth_table"),
     ("baselines.expert",),
     ("baselines.comparison_policies",),
     ("baselines.policies", "baselines"),

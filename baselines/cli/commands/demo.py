@@ -56,7 +56,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     who.add_argument(
         "--policy", default="expert", metavar="SPEC",
         help="the policy that flies the demo: expert | expert-paper | expert-matched | "
-        "minimum-jerk | dynamic-constraints | random | shipped:<stem> | SB3 .zip (default expert)",
+        "expert-smooth | minimum-jerk | dynamic-constraints | random | shipped:<stem> | "
+        "SB3 .zip (default expert)",
     )  # fmt: skip
     who.add_argument(
         "--compare", metavar="A,B", default=None,

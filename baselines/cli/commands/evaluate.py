@@ -106,8 +106,8 @@ GOAL_TABLE_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--policy", action="append", metavar="SPEC",
-        help="expert | expert-paper | expert-matched | dynamic-constraints | minimum-jerk | "
-        "random | path to an SB3 .zip; "
+        help="expert | expert-paper | expert-matched | expert-smooth | dynamic-constraints | "
+        "minimum-jerk | random | path to an SB3 .zip; "
         "repeat or comma-separate for a comparison (default: expert)",
     )  # fmt: skip
     parser.add_argument(
