@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
+from sgc_env.paper.orientation import split_rotation
 from sgc_env.scenario import Body, Scenario
+from sgc_env.scenario.orientation_courses import orientation_courses
 
 __all__ = ["BodyTracks", "Track", "compile_tracks"]
 
@@ -86,21 +87,26 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
     prev_q = tuple(body.orientation)
     prev_t = 0.0
     goals = [body.goals[j] for j in ids]
-    rotations = goal_rotations(prev_q, [(g.orientation, g.relative_rotation) for g in goals])
-    paces = neighbour_paces(
-        rotations, [float(g.time) for g in goals],  # type: ignore[arg-type]
-        body.angular_velocity, body.end_angular_velocity,
+    # Memoised: a random family's feasibility bound computed the same for the body it drew.
+    courses = orientation_courses(
+        prev_q, tuple((g.orientation, g.relative_rotation) for g in goals),
+        tuple(float(g.time) for g in goals),  # type: ignore[arg-type]
+        body.angular_velocity, body.end_angular_velocity, freq,
     )  # fmt: skip
     after_split = False
-    for j, rotation, (rate_in, rate_out) in zip(ids, rotations, paces, strict=True):
+    for k, (j, rotation, split) in enumerate(
+        zip(ids, courses.rotations, courses.splits, strict=True)
+    ):
         g = body.goals[j]
         t = float(g.time)  # type: ignore[arg-type]
         if g.relative_rotation is not None:
-            rel = tuple(float(x) for x in g.relative_rotation)
-            split = split_rotation(
-                rel, prev_t, t, freq, f"{body.name}.goals[{j}]", rate_in=rate_in, rate_out=rate_out
-            )
-            pieces = [(step, end, k == len(split) - 1) for k, (step, end) in enumerate(split)]
+            if split is None:  # refused: split again for the error that names the goal
+                rate_in, rate_out = courses.paces[k]
+                split = tuple(split_rotation(
+                    g.relative_rotation, prev_t, t, freq, f"{body.name}.goals[{j}]",
+                    rate_in=rate_in, rate_out=rate_out,
+                ))  # fmt: skip
+            pieces = [(step, end, i == len(split) - 1) for i, (step, end) in enumerate(split)]
         else:
             q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
             # goal_rotations measured the same step from the same quaternion, unless a split

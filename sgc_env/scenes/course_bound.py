@@ -80,29 +80,40 @@ def _orientation_courses(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Rotation vector and duration of every course of the orientation track, split as the
     planner splits it (``goals``: ``(orientation, relative_rotation)`` each)."""  # fmt: skip
-    # Loaded at the first draw: the orientation module imports scipy, and ``import sgc_env``
+    # Loaded at the first draw: the orientation modules import scipy, and ``import sgc_env``
     # (which reads the families for the registry) stays without it.
-    from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
+    from sgc_env.paper.orientation import split_rotation
+    from sgc_env.scenario.orientation_courses import orientation_courses
 
-    rotations = goal_rotations(start, goals)
-    paces = neighbour_paces(rotations, times, *rates)
+    # Memoised: the env's tracks of a kept rod ask for the same courses (a cache hit).
+    courses = orientation_courses(
+        _floats(start), tuple((_floats(q), _floats(r)) for q, r in goals),
+        tuple(map(float, times)), _floats(rates[0]), _floats(rates[1]), frequency,
+    )  # fmt: skip
     steps: list[tuple[float, ...]] = []
     ends: list[float] = []
     t_prev = 0.0
-    for (_, relative), rotation, t, (rate_in, rate_out) in zip(
-        goals, rotations, times, paces, strict=True
+    for (_, relative), rotation, t, split, (rate_in, rate_out) in zip(
+        goals, courses.rotations, times, courses.splits, courses.paces, strict=True
     ):
         if relative is None:
             steps.append(rotation)
             ends.append(t)
         else:
-            for step, end in split_rotation(
-                rotation, t_prev, t, frequency, rate_in=rate_in, rate_out=rate_out
-            ):
+            if split is None:  # refused: the splitter's error
+                split = tuple(split_rotation(
+                    rotation, t_prev, t, frequency, rate_in=rate_in, rate_out=rate_out
+                ))  # fmt: skip
+            for step, end in split:
                 steps.append(step)
                 ends.append(end)
         t_prev = t
     return np.array(steps, float), np.diff(np.array([0.0, *ends]))
+
+
+def _floats(v: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
+    """A hashable key part: plain floats (the values the orientation functions read)."""
+    return None if v is None else tuple(map(float, v))
 
 
 def spin_feature(
