@@ -135,8 +135,10 @@ def _orientation_courses(
 
 
 def _floats(v: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
-    """A hashable key part: plain floats (the values the orientation functions read)."""
-    return None if v is None else tuple(map(float, v))
+    """A hashable key part (the orientation functions read its entries as floats)."""
+    if v is None or type(v) is tuple:  # the draws' quaternions and rotations already are
+        return v  # type: ignore[return-value]
+    return tuple(map(float, v))
 
 
 def spin_feature(

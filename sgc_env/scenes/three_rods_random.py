@@ -155,7 +155,7 @@ def _vec3(v: np.ndarray) -> tuple[float, float, float]:
 
 def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfig) -> RodSpec:
     """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault)."""
-    points = np.asarray(base.waypoints, float)
+    points = _waypoints(base)
     moved = points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)
     moved[0] = points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)
     hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
@@ -182,6 +182,14 @@ def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfi
         ),
         somersault_sample=None,
     )
+
+
+@lru_cache(maxsize=len(ROD_SPECS))
+def _waypoints(base: RodSpec) -> np.ndarray:
+    """A paper rod's waypoints as an array, made once (the draws only read it)."""
+    points = np.asarray(base.waypoints, float)
+    points.flags.writeable = False
+    return points
 
 
 def _with_somersault(rng: np.random.Generator, spec: RodSpec) -> RodSpec:
@@ -251,6 +259,8 @@ class _Candidate:
     path: RodPath
     ball: Prop
     nails: np.ndarray
+    tip: tuple[float, float, float]
+    """Where the tip starts, as ``course_features`` computes it from the built body."""
     times: list[float]
     fixed: frozenset[int]
     weights: list[float]
@@ -282,22 +292,29 @@ def _candidate_of(
     fixed = {path.pierce: spec.pierce_time, n - 2: hit, n - 1: hit + EMBED_DURATION}
     nails = path.nails.copy()
     nails[path.pierce] = ball.position_at(spec.pierce_time)
-    distances = np.linalg.norm(np.diff(np.vstack((_tip(path), nails)), axis=0), axis=1)
+    tip = _tip(path)
+    # |nail_j - nail_{j-1}| in plain floats (numpy's norm sums the squares in this order)
+    rows = [tip, *nails.tolist()]
+    distances = [
+        math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay) + (bz - az) * (bz - az))
+        for (ax, ay, az), (bx, by, bz) in zip(rows[:-1], rows[1:], strict=True)
+    ]
     somersault = spec.somersault_sample if path.turn is not None else None
     weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
     routed = resolve_goal_times(
         [None if j not in fixed else grid_time(fixed[j], f) for j in range(n)],
-        [j in fixed for j in range(n)], distances.tolist(), weights,
+        [j in fixed for j in range(n)], distances, weights,
     )  # fmt: skip
     times = [grid_time(float(t), f) for t in routed]
     if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
         return None
-    return _Candidate(path, ball, nails, times, frozenset(fixed), weights, somersault, f)
+    return _Candidate(path, ball, nails, tip, times, frozenset(fixed), weights, somersault, f)
 
 
-def _tip(path: RodPath) -> np.ndarray:
+def _tip(path: RodPath) -> tuple[float, float, float]:
     """The tip's start, as ``course_features`` computes it from the built body."""
-    return np.asarray(_vec3(path.com_start)) + np.asarray(quat.rotate(path.start, TIP))
+    (x, y, z), (dx, dy, dz) = _vec3(path.com_start), quat.rotate(path.start, TIP)
+    return x + dx, y + dy, z + dz
 
 
 def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | None]]:
@@ -309,17 +326,26 @@ def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | Non
 
 def _candidate_bound(c: _Candidate, k: int) -> tuple[float, float] | None:
     """:func:`rod_bound` of the rod's scene, from its arrays (the same floats)."""
-    rest = np.zeros(3)
+    rest = _REST
     spin = spin_feature(c.path.start, _orientation_goals(c), c.times, (rest, rest), c.frequency)
     if spin is None:
         return None
-    launch = np.asarray(_vec3(c.path.launch))
-    point = point_feature(c.times, _tip(c.path), c.nails, launch, rest)
-    gravity = float(np.linalg.norm(_template().gravity))
+    point = point_feature(c.times, np.asarray(c.tip), c.nails, c.path.launch, rest)
     return demand_bound(
-        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA,
-        arm=float(np.linalg.norm(TIP)), gravity=gravity,
+        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA, arm=TIP_ARM,
+        gravity=_gravity(),
     )  # fmt: skip
+
+
+_REST = np.zeros(3)
+_REST.flags.writeable = False
+TIP_ARM = float(np.linalg.norm(TIP))
+"""The tracked point's distance from the centre of mass (``body_bound``'s ``arm``)."""
+
+
+@lru_cache(maxsize=1)
+def _gravity() -> float:
+    return float(np.linalg.norm(_template().gravity))
 
 
 def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
