@@ -137,7 +137,7 @@ def _orientation_courses(
 def _floats(v: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
     """A hashable key part (the orientation functions read its entries as floats)."""
     if v is None or type(v) is tuple:  # the draws' quaternions and rotations already are
-        return v  # type: ignore[return-value]
+        return v
     return tuple(map(float, v))
 
 
