@@ -108,7 +108,7 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
                 ))  # fmt: skip
             pieces = [(step, end, i == len(split) - 1) for i, (step, end) in enumerate(split)]
         else:
-            q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
+            q = tuple(map(float, g.orientation))  # type: ignore[arg-type]
             # goal_rotations measured the same step from the same quaternion, unless a split
             # relative rotation came before (its pieces compose to other floats).
             step = quat.log(quat.mul_conjugate(q, prev_q)) if after_split else rotation
