@@ -145,7 +145,7 @@ PHASES = (
     ("bound", three_rods_random, "_candidate_bound"),
     ("build", three_rods_random, "rod_path"),
     ("resolve", intercept, "resolve_scenario"),
-    ("resolve", three_rods_random, "resolve_goal_times"),
+    ("resolve", three_rods_random, "_route"),
     ("resolve", three_rods_random, "_rod_scene"),
 )
 """Where a draw's CPU time goes: the planner, the feasibility bound (the intercept's sampling

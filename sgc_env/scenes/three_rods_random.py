@@ -27,7 +27,7 @@ from functools import lru_cache
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.routing import resolve_goal_times
+from sgc_env.paper.routing import _cumulative_fractions
 from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
 from sgc_env.scenario.demand import inertia_diagonal
 from sgc_env.scenario.model import Vec3, grid_time
@@ -301,14 +301,29 @@ def _candidate_of(
     ]
     somersault = spec.somersault_sample if path.turn is not None else None
     weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
-    routed = resolve_goal_times(
-        [None if j not in fixed else grid_time(fixed[j], f) for j in range(n)],
-        [j in fixed for j in range(n)], distances, weights,
-    )  # fmt: skip
-    times = [grid_time(float(t), f) for t in routed]
+    anchors = [(j, grid_time(fixed[j], f)) for j in sorted(fixed)]
+    times = [grid_time(t, f) for t in _route(distances, weights, anchors)]
     if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
         return None
     return _Candidate(path, ball, nails, tip, times, frozenset(fixed), weights, somersault, f)
+
+
+def _route(
+    distances: list[float], weights: list[float], anchors: list[tuple[int, float]]
+) -> list[float]:
+    """``resolve_goal_times`` of goals whose time-critical ones are ``anchors`` (index, time;
+    increasing, the last goal last): its arithmetic without its per-goal checks, which cost
+    as much as the rest of the routing and which a drawn rod passes by construction (its
+    course lengths are positive; the times are checked on the grid afterwards)."""
+    out: list[float] = []
+    first, t0 = 0, 0.0
+    for last, t in anchors:
+        if last > first:
+            share = np.divide(distances[first : last + 1], weights[first : last + 1])
+            out += (t0 + (t - t0) * _cumulative_fractions(share))[:-1].tolist()
+        out.append(t)
+        first, t0 = last + 1, t
+    return out
 
 
 def _tip(path: RodPath) -> tuple[float, float, float]:
