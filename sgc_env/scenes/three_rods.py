@@ -134,9 +134,12 @@ def _spline(points: np.ndarray):
         knots.append(total)
     from scipy.interpolate import make_interp_spline
 
-    # check_finite off: the waypoints are finite by construction (it only skips a check).
+    # check_finite off: the waypoints are finite by construction (it only skips a check);
+    # the not-a-knot knot vector scipy would build (cubic: the ends four times, the inner
+    # sites but the second and the second last), given so that it is not built by np.r_.
     knot_array = np.array(knots)
-    return make_interp_spline(knot_array, points, k=3, check_finite=False), knot_array
+    t = np.array([knots[0]] * 4 + knots[2:-2] + [knots[-1]] * 4)
+    return make_interp_spline(knot_array, points, k=3, t=t, check_finite=False), knot_array
 
 
 def _arc_length_samples(

@@ -154,32 +154,35 @@ def _vec3(v: np.ndarray) -> tuple[float, float, float]:
 
 
 def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfig) -> RodSpec:
-    """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault)."""
+    """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault).
+    The draws' order is the family's definition; the clamps and the ball's direction are
+    plain floats (the same values as on the arrays, at a fraction of numpy's per-call cost)."""
     points = _waypoints(base)
-    moved = points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)
-    moved[0] = points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)
+    moved = (points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)).tolist()
+    moved[0] = (points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)).tolist()
     hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
-    hit = points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)
-    hit[0] = TARGET_FACE_X
-    hit[1] = min(max(hit[1], TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
-    hit[2] = min(max(hit[2], TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
-    moved[-1] = hit
+    _, y, z = (points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)).tolist()
+    y = min(max(y, TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
+    z = min(max(z, TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
+    moved[-1] = [TARGET_FACE_X, y, z]
     moved[-2][0] = min(moved[-2][0], TARGET_FACE_X - 2.0)
     f = cfg.control_frequency
     direction = rng.normal(size=3)
     after = base.samples_after + int(
         rng.integers(-cfg.samples_after_change, cfg.samples_after_change + 1)
     )
+    samples_before = int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1))
+    hit_time = grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f)
+    pierce_time = grid_time(rng.uniform(*cfg.pierce_time), f)
+    norm, speed = float(np.linalg.norm(direction)), rng.uniform(*cfg.ball_speed)
     return replace(
         base,
-        waypoints=tuple(map(tuple, moved.tolist())),
-        samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
+        waypoints=tuple(map(tuple, moved)),
+        samples_before=samples_before,
         samples_after=after,
-        hit_time=grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
-        pierce_time=grid_time(rng.uniform(*cfg.pierce_time), f),
-        ball_velocity=tuple(
-            (direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)).tolist()
-        ),
+        hit_time=hit_time,
+        pierce_time=pierce_time,
+        ball_velocity=tuple(c / norm * speed for c in direction.tolist()),
         somersault_sample=None,
     )
 
