@@ -97,30 +97,34 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
     for k, (j, rotation, split) in enumerate(
         zip(ids, courses.rotations, courses.splits, strict=True)
     ):
-        g = body.goals[j]
+        g = goals[k]
         t = float(g.time)  # type: ignore[arg-type]
-        if g.relative_rotation is not None:
+        if g.relative_rotation is None:
+            q = tuple(map(float, g.orientation))  # type: ignore[arg-type]
+            # goal_rotations measured the same step from the same quaternion, unless a split
+            # relative rotation came before (its pieces compose to other floats).
+            step = quat.log(quat.mul_conjugate(q, prev_q)) if after_split else rotation
+            prev_q, after_split = q, False
+            goal_ids.append(j)
+            quats.append(q)
+            starts.append((-step[0], -step[1], -step[2]))
+            times.append(t)
+            via.append(False)
+        else:
             if split is None:  # refused: split again for the error that names the goal
                 rate_in, rate_out = courses.paces[k]
                 split = tuple(split_rotation(
                     g.relative_rotation, prev_t, t, freq, f"{body.name}.goals[{j}]",
                     rate_in=rate_in, rate_out=rate_out,
                 ))  # fmt: skip
-            pieces = [(step, end, i == len(split) - 1) for i, (step, end) in enumerate(split)]
-        else:
-            q = tuple(map(float, g.orientation))  # type: ignore[arg-type]
-            # goal_rotations measured the same step from the same quaternion, unless a split
-            # relative rotation came before (its pieces compose to other floats).
-            step = quat.log(quat.mul_conjugate(q, prev_q)) if after_split else rotation
-            pieces = [(step, t, True)]
-        after_split = g.relative_rotation is not None
-        for step, t_piece, last in pieces:
-            prev_q = quat.mul(quat.exp_normalized(step), prev_q) if g.relative_rotation else q
-            goal_ids.append(j)
-            quats.append(prev_q)
-            starts.append((-step[0], -step[1], -step[2]))
-            times.append(t_piece)
-            via.append(not last)
+            for i, (step, end) in enumerate(split, 1 - len(split)):  # i == 0: the last piece
+                prev_q = quat.mul(quat.exp_normalized(step), prev_q)
+                goal_ids.append(j)
+                quats.append(prev_q)
+                starts.append((-step[0], -step[1], -step[2]))
+                times.append(end)
+                via.append(i != 0)
+            after_split = True
         prev_t = t
     end_w = (
         np.zeros(3) if body.end_angular_velocity is None else np.asarray(body.end_angular_velocity)
