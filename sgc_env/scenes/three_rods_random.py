@@ -14,6 +14,10 @@ plan needs (``sgc_env.scenes.course_bound``, with this family's measured factors
 Planning every draw (v1) made a reset cost ~170 ms; the bound costs a fraction of a
 millisecond, and each rod is built straight into model objects (``_rod_scene``) instead of
 YAML-ready data that is parsed and resolved (``docs/environments.md`` has the figures).
+A draw is issue 19's 10 ms budget: its orientation courses are memoised for the env's tracks
+(``sgc_env.scenario.orientation_courses``), its small-vector arithmetic is plain floats and
+its routing skips the checks a drawn rod passes by construction (``_route``), all giving the
+floats they replaced, bit for bit.
 ``tests/test_random_scenes.py`` checks the bound against the planner on fresh draws and runs
 the expert inside PyBullet on the draws.
 """
