@@ -146,7 +146,7 @@ PHASES = (
     ("build", three_rods_random, "rod_path"),
     ("resolve", intercept, "resolve_scenario"),
     ("resolve", three_rods_random, "_route"),
-    ("resolve", three_rods_random, "_rod_scene"),
+    ("resolve", three_rods_random, "_rod_body"),
 )
 """Where a draw's CPU time goes: the planner, the feasibility bound (the intercept's sampling
 of the plan, ``bound`` minus ``plan``; the rods' planner-free course bound), sampling the

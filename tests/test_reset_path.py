@@ -109,9 +109,9 @@ def test_the_plain_float_course_bound_gives_numpys_floats():
         assert course_bound.point_feature(c.times, np.asarray(c.tip), c.nails, c.path.launch,
                                           rest) == point  # fmt: skip
         goals = family._orientation_goals(c)
-        steps, ends = course_bound._orientation_courses(c.path.start, goals, c.times,
-                                                        (rest, rest), 60)  # fmt: skip
-        steps, durations = np.array(steps), np.diff(np.array([0.0, *ends]))
+        steps, durations = course_bound._orientation_courses(c.path.start, goals, c.times,
+                                                             (rest, rest), 60)  # fmt: skip
+        steps, durations = np.array(steps), np.array(durations)
         w = steps / durations[:, None]
         speeds = np.linalg.norm(w, axis=1)
         incoming = np.concatenate(([0.0], speeds[:-1]))

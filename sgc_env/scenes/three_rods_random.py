@@ -215,18 +215,19 @@ def random_three_rods(
     gold rod does not cost the teal and violet ones their plans)."""
     cfg = config or RandomThreeRodsConfig()
     rods = [_feasible_rod(rng, k, cfg) for k in range(len(ROD_SPECS))]
-    target = rods[0].props[-1]
+    template = _template()
     return replace(
-        rods[0],
-        name="three_rods_random",
-        bodies=tuple(r.bodies[0] for r in rods),
-        props=(*(r.props[0] for r in rods), target),
-    )
+        template, bodies=tuple(body for body, _ in rods),
+        props=(*(ball for _, ball in rods), template.props[-1]),
+        control_frequency=cfg.control_frequency, resolved=True,
+    )  # fmt: skip
 
 
-def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
-    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits;
-    model objects are built only for the rod kept."""
+def _feasible_rod(
+    rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig
+) -> tuple[Body, Prop]:
+    """Rod ``k``'s body and ball, drawn until within the limits; model objects are built
+    only for the rod kept."""
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
         candidate = _candidate(rng, k, cfg)
@@ -234,7 +235,7 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
         if bound is None or candidate is None:
             continue
         if bound[0] <= share * cfg.force_limit and bound[1] <= share * cfg.torque_limit:
-            return _rod_scene(candidate, cfg)
+            return _rod_body(candidate, cfg), candidate.ball
     raise RuntimeError(
         f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
         "the limits"
@@ -374,6 +375,15 @@ def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
     """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
     and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
     of their cost (the field checks and dict round trips were half of a draw)."""
+    template = _template()
+    return replace(
+        template, bodies=(_rod_body(c, cfg),), props=(c.ball, template.props[-1]),
+        control_frequency=c.frequency, resolved=True,
+    )  # fmt: skip
+
+
+def _rod_body(c: _Candidate, cfg: RandomThreeRodsConfig) -> Body:
+    """The body of :func:`_rod_scene` (the draws assemble one scene of the three)."""
     spec, rows = c.path.spec, c.nails.tolist()
     goals = tuple(
         Goal(
@@ -388,17 +398,12 @@ def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
         )  # fmt: skip
         for j, (orientation, relative) in enumerate(_orientation_goals(c))
     )
-    body = Body(
+    return Body(
         name=spec.name, shape="rod", size=(ROD_LENGTH, ROD_RADIUS), mass=ROD_MASS,
         position=_vec3(c.path.com_start), orientation=c.path.start,
         linear_velocity=_vec3(c.path.launch), color=spec.color,
         force_limit=float(cfg.force_limit), torque_limit=float(cfg.torque_limit), goals=goals,
         end_velocity=(0.0, 0.0, 0.0), end_angular_velocity=(0.0, 0.0, 0.0), collisions=False,
-    )  # fmt: skip
-    template = _template()
-    return replace(
-        template, bodies=(body,), props=(c.ball, template.props[-1]),
-        control_frequency=c.frequency, resolved=True,
     )  # fmt: skip
 
 
