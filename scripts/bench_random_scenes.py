@@ -6,7 +6,8 @@ time on the unwrapped env over ``--rounds`` rounds; the same in process CPU time
 what other jobs on a shared machine inflate least, and PyBullet DIRECT runs in this process);
 the wall time's ratio to a bare PyBullet reset measured in the same run (one body of a DIRECT
 client put back to its start pose and velocity); its share of stepping a full-length episode
-(``% episode``); the redraw rate (feasibility checks per kept scene; ``-`` for families whose
+(``% episode``); the redraw rate (``checks/scene``: feasibility checks per kept scene, and
+``redraw %``: the share of checked draws rejected and drawn again; ``-`` for families whose
 draw is feasible by construction and never checks); and whether the wall time (``yes``), only
 the CPU time (``cpu``) or neither (``no``) stays within issue 19's 10 ms. Then, as before:
 
@@ -106,9 +107,11 @@ def _episode_ms(env_id: str, steps: int) -> float:
     return elapsed / steps * length * 1e3
 
 
-def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
-    """Checks per kept scene, and the mean ms of one check (0 checks: nan)."""
-    calls, seconds = [0], [0.0]
+def _draws_per_scene(family: str, scenes: int) -> tuple[float, float, float]:
+    """Checks per kept scene, the mean ms of one check (0 checks: nan) and the share of
+    checked draws redrawn (each check keeps a body or redraws it: the intercept checks its
+    one body per scene, the three rods each rod on its own)."""
+    calls, seconds, kept = [0], [0.0], 0
     checks = ((intercept, "demand_bounds"), (three_rods_random, "_candidate_bound"))
     saved = [getattr(module, name) for module, name in checks]
 
@@ -127,11 +130,13 @@ def _draws_per_scene(family: str, scenes: int) -> tuple[float, float]:
     try:
         rng = np.random.default_rng(0)
         for _ in range(scenes):
-            random_scenario(rng, family)
+            kept += len(random_scenario(rng, family).bodies)
     finally:
         for (module, name), check in zip(checks, saved, strict=True):
             setattr(module, name, check)
-    return calls[0] / scenes, (seconds[0] / calls[0] * 1e3 if calls[0] else float("nan"))
+    if not calls[0]:
+        return 0.0, float("nan"), float("nan")
+    return calls[0] / scenes, seconds[0] / calls[0] * 1e3, 1.0 - kept / calls[0]
 
 
 PHASES = (
@@ -140,8 +145,8 @@ PHASES = (
     ("bound", three_rods_random, "_candidate_bound"),
     ("build", three_rods_random, "rod_path"),
     ("resolve", intercept, "resolve_scenario"),
-    ("resolve", three_rods_random, "resolve_goal_times"),
-    ("resolve", three_rods_random, "_rod_scene"),
+    ("resolve", three_rods_random, "_route"),
+    ("resolve", three_rods_random, "_rod_body"),
 )
 """Where a draw's CPU time goes: the planner, the feasibility bound (the intercept's sampling
 of the plan, ``bound`` minus ``plan``; the rods' planner-free course bound), sampling the
@@ -209,11 +214,11 @@ def main() -> None:
     bare = _bare_reset_ms(2000)
     print(f"bare PyBullet reset: {bare * 1e3:.1f} us")
     print(f"{'id':24s} {'reset ms':>9s} {'cpu ms':>8s} {'x bare':>8s} {'% episode':>9s}"
-          f" {'checks/scene':>12s} {'<= 10 ms':>9s}")  # fmt: skip
+          f" {'checks/scene':>12s} {'redraw %':>8s} {'<= 10 ms':>9s}")  # fmt: skip
     for env_id, preset in _random_ids():
         ms, cpu = _reset_ms(env_id, args.resets, args.rounds)
-        draws, _ = _draws_per_scene(preset, args.resets)
-        rate = f"{draws:12.2f}" if draws else f"{'-':>12s}"
+        draws, _, redrawn = _draws_per_scene(preset, args.resets)
+        rate = f"{draws:12.2f} {100 * redrawn:8.1f}" if draws else f"{'-':>12s} {'-':>8s}"
         verdict = "yes" if ms <= TARGET_MS else ("cpu" if cpu <= TARGET_MS else "no")
         share = 100 * ms / _episode_ms(env_id, 1000)
         print(f"{env_id:24s} {ms:9.2f} {cpu:8.2f} {ms / bare:8.0f} {share:9.1f} {rate}"
@@ -224,7 +229,7 @@ def main() -> None:
     for fixed, random_id, family in PAIRS:
         base, _ = _reset_ms(fixed, args.resets)
         drawn, _ = _reset_ms(random_id, args.resets)
-        draws, check_ms = _draws_per_scene(family, args.resets)
+        draws, check_ms, _ = _draws_per_scene(family, args.resets)
         episode = _episode_ms(random_id, 2000)
         print(f"{fixed:24s} {base:9.2f}")
         print(f"{random_id:24s} {drawn:9.2f} {drawn / base:8.0f} {draws:12.2f} {check_ms:9.2f}"

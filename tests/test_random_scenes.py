@@ -13,6 +13,7 @@ import pytest
 import sgc_env
 from baselines.expert import SGCExpert
 from sgc_env.envs import SGCEnv
+from sgc_env.paper.routing import resolve_goal_times
 from sgc_env.scenario import resolve_scenario, scenario_from_dict
 from sgc_env.scenario.demand import demand_bounds
 from sgc_env.scenes import RandomInterceptConfig, RandomThreeRodsConfig, random_scenario
@@ -181,6 +182,24 @@ def test_a_drawn_rod_is_what_the_yaml_route_makes_of_it(k):
         assert fast.resolved
         _close(fast, slow)
         assert [g.time for g in fast.bodies[0].goals] == [g.time for g in slow.bodies[0].goals]
+
+
+def test_the_rods_routing_is_resolve_goal_times_without_its_checks():
+    """The three-rod draws route their goal times with ``_route`` (the routing's arithmetic
+    without its per-goal checks): the same floats as ``resolve_goal_times``."""
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        n = int(rng.integers(3, 30))
+        distances = rng.uniform(0.01, 2.0, n).tolist()
+        weights = rng.choice([1.0, 0.3], n).tolist()
+        critical = sorted({int(j) for j in rng.integers(0, n - 1, 2)} | {n - 2, n - 1})
+        times = np.cumsum(rng.uniform(0.1, 1.0, len(critical))).tolist()
+        anchors = list(zip(critical, times, strict=True))
+        expected = resolve_goal_times(
+            [dict(anchors).get(j) for j in range(n)], [j in critical for j in range(n)],
+            distances, weights,
+        )  # fmt: skip
+        assert random_three_rods._route(distances, weights, anchors) == expected.tolist()
 
 
 def test_the_course_bound_stays_above_the_planners_on_fresh_draws():

@@ -12,8 +12,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
+from sgc_env.paper.orientation import split_rotation
 from sgc_env.scenario import Body, Scenario
+from sgc_env.scenario.orientation_courses import orientation_courses
 
 __all__ = ["BodyTracks", "Track", "compile_tracks"]
 
@@ -86,35 +87,44 @@ def _orientation_track(body: Body, freq: int) -> Track | None:
     prev_q = tuple(body.orientation)
     prev_t = 0.0
     goals = [body.goals[j] for j in ids]
-    rotations = goal_rotations(prev_q, [(g.orientation, g.relative_rotation) for g in goals])
-    paces = neighbour_paces(
-        rotations, [float(g.time) for g in goals],  # type: ignore[arg-type]
-        body.angular_velocity, body.end_angular_velocity,
+    # Memoised: a random family's feasibility bound computed the same for the body it drew.
+    courses = orientation_courses(
+        prev_q, tuple((g.orientation, g.relative_rotation) for g in goals),
+        tuple(float(g.time) for g in goals),  # type: ignore[arg-type]
+        body.angular_velocity, body.end_angular_velocity, freq,
     )  # fmt: skip
     after_split = False
-    for j, rotation, (rate_in, rate_out) in zip(ids, rotations, paces, strict=True):
-        g = body.goals[j]
+    for k, (j, rotation, split) in enumerate(
+        zip(ids, courses.rotations, courses.splits, strict=True)
+    ):
+        g = goals[k]
         t = float(g.time)  # type: ignore[arg-type]
-        if g.relative_rotation is not None:
-            rel = tuple(float(x) for x in g.relative_rotation)
-            split = split_rotation(
-                rel, prev_t, t, freq, f"{body.name}.goals[{j}]", rate_in=rate_in, rate_out=rate_out
-            )
-            pieces = [(step, end, k == len(split) - 1) for k, (step, end) in enumerate(split)]
-        else:
-            q = tuple(float(x) for x in g.orientation)  # type: ignore[union-attr]
+        if g.relative_rotation is None:
+            q = tuple(map(float, g.orientation))  # type: ignore[arg-type]
             # goal_rotations measured the same step from the same quaternion, unless a split
             # relative rotation came before (its pieces compose to other floats).
             step = quat.log(quat.mul_conjugate(q, prev_q)) if after_split else rotation
-            pieces = [(step, t, True)]
-        after_split = g.relative_rotation is not None
-        for step, t_piece, last in pieces:
-            prev_q = quat.mul(quat.exp_normalized(step), prev_q) if g.relative_rotation else q
+            prev_q, after_split = q, False
             goal_ids.append(j)
-            quats.append(prev_q)
+            quats.append(q)
             starts.append((-step[0], -step[1], -step[2]))
-            times.append(t_piece)
-            via.append(not last)
+            times.append(t)
+            via.append(False)
+        else:
+            if split is None:  # refused: split again for the error that names the goal
+                rate_in, rate_out = courses.paces[k]
+                split = tuple(split_rotation(
+                    g.relative_rotation, prev_t, t, freq, f"{body.name}.goals[{j}]",
+                    rate_in=rate_in, rate_out=rate_out,
+                ))  # fmt: skip
+            for i, (step, end) in enumerate(split, 1 - len(split)):  # i == 0: the last piece
+                prev_q = quat.mul(quat.exp_normalized(step), prev_q)
+                goal_ids.append(j)
+                quats.append(prev_q)
+                starts.append((-step[0], -step[1], -step[2]))
+                times.append(end)
+                via.append(i != 0)
+            after_split = True
         prev_t = t
     end_w = (
         np.zeros(3) if body.end_angular_velocity is None else np.asarray(body.end_angular_velocity)

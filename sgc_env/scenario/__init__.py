@@ -5,7 +5,8 @@ A scenario is plain frozen data. :func:`resolve_scenario` turns a user scenario 
 the environment runs (every goal timed on the control grid, prop nails computed, the plan the
 expert flies checked against the limits); :func:`load_scenario` reads one from YAML first.
 Modules, bottom up: ``model`` <- ``fields`` <- ``curves`` <- ``parse``; ``validate`` <-
-``demand`` <- ``resolve`` <- ``load``.
+``demand`` <- ``resolve`` <- ``load``; ``orientation_courses`` (an orientation track's
+courses, memoised for the env's tracks and the three-rod course bound; not imported here).
 """
 
 from __future__ import annotations

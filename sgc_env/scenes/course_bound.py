@@ -24,6 +24,7 @@ than ``PACE_JUMP`` times its own pace has no features (``None``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -47,10 +48,27 @@ CourseFeatures = tuple[float, float]
 """``(point, spin)``: see the module docstring."""
 
 
-def _changes(velocities: np.ndarray, before: np.ndarray, after: np.ndarray) -> np.ndarray:
-    """``|v_j - v_{j-1}| + |v_{j+1} - v_j|`` per course (rows of 3-vectors)."""
-    steps = np.linalg.norm(np.diff(np.vstack((before, velocities, after)), axis=0), axis=1)
-    return steps[:-1] + steps[1:]
+def _vector(v: Sequence[float] | np.ndarray) -> tuple[float, float, float]:
+    x, y, z = map(float, v)
+    return x, y, z
+
+
+def _changes(
+    velocities: Sequence[Sequence[float]], before: Sequence[float], after: Sequence[float]
+) -> list[float]:
+    """``|v_j - v_{j-1}| + |v_{j+1} - v_j|`` per course (3-vectors). Plain floats: the same
+    arithmetic as numpy's ``norm(diff(...), axis=1)`` (a sum of squares in axis order), several
+    times cheaper on the ~20 rows of a course list (and a draw checks three or four)."""
+    rows = [before, *velocities, after]
+    steps = [
+        math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay) + (bz - az) * (bz - az))
+        for (ax, ay, az), (bx, by, bz) in zip(rows[:-1], rows[1:], strict=True)
+    ]
+    return [a + b for a, b in zip(steps[:-1], steps[1:], strict=True)]
+
+
+def _durations(times: Sequence[float]) -> list[float]:
+    return [b - a for a, b in zip([0.0, *times[:-1]], times, strict=True)]
 
 
 def _end(v: tuple[float, float, float] | None) -> np.ndarray:
@@ -66,9 +84,14 @@ def point_feature(
 ) -> float:
     """``point`` of a tracked point starting at ``start`` with ``velocity`` and passing
     ``nails`` (rows) at ``times``."""  # fmt: skip
-    durations = np.diff(np.array([0.0, *times], float))
-    velocities = np.diff(np.vstack((start, nails)), axis=0) / durations[:, None]
-    return float(np.max(_changes(velocities, velocity, end_velocity) / durations))
+    durations = _durations([float(t) for t in times])
+    points = [_vector(start), *np.asarray(nails, float).tolist()]
+    velocities = [
+        ((bx - ax) / d, (by - ay) / d, (bz - az) / d)
+        for (ax, ay, az), (bx, by, bz), d in zip(points[:-1], points[1:], durations, strict=True)
+    ]
+    changes = _changes(velocities, _vector(velocity), _vector(end_velocity))
+    return max(c / d for c, d in zip(changes, durations, strict=True))
 
 
 def _orientation_courses(
@@ -77,32 +100,45 @@ def _orientation_courses(
     times: Sequence[float],
     rates: tuple[np.ndarray, np.ndarray],
     frequency: int,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[list[tuple[float, ...]], list[float]]:
     """Rotation vector and duration of every course of the orientation track, split as the
     planner splits it (``goals``: ``(orientation, relative_rotation)`` each)."""  # fmt: skip
-    # Loaded at the first draw: the orientation module imports scipy, and ``import sgc_env``
+    # Loaded at the first draw: the orientation modules import scipy, and ``import sgc_env``
     # (which reads the families for the registry) stays without it.
-    from sgc_env.paper.orientation import goal_rotations, neighbour_paces, split_rotation
+    from sgc_env.paper.orientation import split_rotation
+    from sgc_env.scenario.orientation_courses import orientation_courses
 
-    rotations = goal_rotations(start, goals)
-    paces = neighbour_paces(rotations, times, *rates)
+    # Memoised: the env's tracks of a kept rod ask for the same courses (a cache hit).
+    courses = orientation_courses(
+        _floats(start), tuple((_floats(q), _floats(r)) for q, r in goals),
+        tuple(map(float, times)), _floats(rates[0]), _floats(rates[1]), frequency,
+    )  # fmt: skip
     steps: list[tuple[float, ...]] = []
     ends: list[float] = []
     t_prev = 0.0
-    for (_, relative), rotation, t, (rate_in, rate_out) in zip(
-        goals, rotations, times, paces, strict=True
+    for (_, relative), rotation, t, split, (rate_in, rate_out) in zip(
+        goals, courses.rotations, times, courses.splits, courses.paces, strict=True
     ):
         if relative is None:
             steps.append(rotation)
             ends.append(t)
         else:
-            for step, end in split_rotation(
-                rotation, t_prev, t, frequency, rate_in=rate_in, rate_out=rate_out
-            ):
+            if split is None:  # refused: the splitter's error
+                split = tuple(split_rotation(
+                    rotation, t_prev, t, frequency, rate_in=rate_in, rate_out=rate_out
+                ))  # fmt: skip
+            for step, end in split:
                 steps.append(step)
                 ends.append(end)
         t_prev = t
-    return np.array(steps, float), np.diff(np.array([0.0, *ends]))
+    return steps, _durations(ends)
+
+
+def _floats(v: Sequence[float] | np.ndarray | None) -> tuple[float, ...] | None:
+    """A hashable key part (the orientation functions read its entries as floats)."""
+    if v is None or type(v) is tuple:  # the draws' quaternions and rotations already are
+        return v
+    return tuple(map(float, v))
 
 
 def spin_feature(
@@ -117,17 +153,20 @@ def spin_feature(
     angular velocities; None where a course is entered faster than ``PACE_JUMP`` times its own
     pace."""  # fmt: skip
     steps, durations = _orientation_courses(start, goals, times, rates, frequency)
-    velocities = steps / durations[:, None]
-    speeds = np.linalg.norm(velocities, axis=1)
-    ends = np.array([np.linalg.norm(rates[0]), np.linalg.norm(rates[1])])
-    incoming = np.concatenate((ends[:1], speeds[:-1]))
-    moving = speeds > 1e-9
-    if np.any(incoming[moving] > PACE_JUMP * speeds[moving]):
-        return None
-    padded = np.concatenate((ends[:1], speeds, ends[1:]))
-    fastest = np.maximum(np.maximum(padded[:-2], padded[1:-1]), padded[2:])
-    change = _changes(velocities, *rates) / durations
-    return float(np.max(change + SPIN_RATE * fastest**2))
+    velocities = [(x / d, y / d, z / d) for (x, y, z), d in zip(steps, durations, strict=True)]
+    speeds = [math.sqrt(x * x + y * y + z * z) for x, y, z in velocities]
+    first, last = (float(np.linalg.norm(r)) for r in rates)
+    for incoming, speed in zip([first, *speeds[:-1]], speeds, strict=True):
+        if speed > 1e-9 and incoming > PACE_JUMP * speed:
+            return None
+    padded = [first, *speeds, last]
+    changes = _changes(velocities, _vector(rates[0]), _vector(rates[1]))
+    return max(
+        c / d + SPIN_RATE * (f * f)
+        for c, d, f in zip(
+            changes, durations, map(max, padded[:-2], padded[1:-1], padded[2:]), strict=True
+        )
+    )
 
 
 def course_features(b: Body, frequency: int) -> CourseFeatures | None:

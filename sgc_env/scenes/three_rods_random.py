@@ -14,6 +14,10 @@ plan needs (``sgc_env.scenes.course_bound``, with this family's measured factors
 Planning every draw (v1) made a reset cost ~170 ms; the bound costs a fraction of a
 millisecond, and each rod is built straight into model objects (``_rod_scene``) instead of
 YAML-ready data that is parsed and resolved (``docs/environments.md`` has the figures).
+A draw is issue 19's 10 ms budget: its orientation courses are memoised for the env's tracks
+(``sgc_env.scenario.orientation_courses``), its small-vector arithmetic is plain floats and
+its routing skips the checks a drawn rod passes by construction (``_route``), all giving the
+floats they replaced, bit for bit.
 ``tests/test_random_scenes.py`` checks the bound against the planner on fresh draws and runs
 the expert inside PyBullet on the draws.
 """
@@ -27,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.routing import resolve_goal_times
+from sgc_env.paper.routing import _cumulative_fractions
 from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
 from sgc_env.scenario.demand import inertia_diagonal
 from sgc_env.scenario.model import Vec3, grid_time
@@ -154,34 +158,45 @@ def _vec3(v: np.ndarray) -> tuple[float, float, float]:
 
 
 def _rod_spec(rng: np.random.Generator, base: RodSpec, cfg: RandomThreeRodsConfig) -> RodSpec:
-    """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault)."""
-    points = np.asarray(base.waypoints, float)
-    moved = points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)
-    moved[0] = points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)
+    """``base`` with drawn waypoints, goal counts, times and ball velocity (no somersault).
+    The draws' order is the family's definition; the clamps and the ball's direction are
+    plain floats (the same values as on the arrays, at a fraction of numpy's per-call cost)."""
+    points = _waypoints(base)
+    moved = (points + rng.uniform(-cfg.waypoint_spread, cfg.waypoint_spread, points.shape)).tolist()
+    moved[0] = (points[0] + rng.uniform(-cfg.start_spread, cfg.start_spread, 3)).tolist()
     hy, hz = TARGET_HALF_EXTENTS[1] - 0.5, TARGET_HALF_EXTENTS[2] - 0.5
-    hit = points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)
-    hit[0] = TARGET_FACE_X
-    hit[1] = min(max(hit[1], TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
-    hit[2] = min(max(hit[2], TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
-    moved[-1] = hit
+    _, y, z = (points[-1] + rng.uniform(-cfg.hit_spread, cfg.hit_spread, 3)).tolist()
+    y = min(max(y, TARGET_CENTER[1] - hy), TARGET_CENTER[1] + hy)
+    z = min(max(z, TARGET_CENTER[2] - hz), TARGET_CENTER[2] + hz)
+    moved[-1] = [TARGET_FACE_X, y, z]
     moved[-2][0] = min(moved[-2][0], TARGET_FACE_X - 2.0)
     f = cfg.control_frequency
     direction = rng.normal(size=3)
     after = base.samples_after + int(
         rng.integers(-cfg.samples_after_change, cfg.samples_after_change + 1)
     )
+    samples_before = int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1))
+    hit_time = grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f)
+    pierce_time = grid_time(rng.uniform(*cfg.pierce_time), f)
+    norm, speed = float(np.linalg.norm(direction)), rng.uniform(*cfg.ball_speed)
     return replace(
         base,
-        waypoints=tuple(map(tuple, moved.tolist())),
-        samples_before=int(rng.integers(cfg.samples_before[0], cfg.samples_before[1] + 1)),
+        waypoints=tuple(map(tuple, moved)),
+        samples_before=samples_before,
         samples_after=after,
-        hit_time=grid_time(base.hit_time + rng.uniform(-1, 1) * cfg.hit_time_change, f),
-        pierce_time=grid_time(rng.uniform(*cfg.pierce_time), f),
-        ball_velocity=tuple(
-            (direction / np.linalg.norm(direction) * rng.uniform(*cfg.ball_speed)).tolist()
-        ),
+        hit_time=hit_time,
+        pierce_time=pierce_time,
+        ball_velocity=tuple(c / norm * speed for c in direction.tolist()),
         somersault_sample=None,
     )
+
+
+@lru_cache(maxsize=len(ROD_SPECS))
+def _waypoints(base: RodSpec) -> np.ndarray:
+    """A paper rod's waypoints as an array, made once (the draws only read it)."""
+    points = np.asarray(base.waypoints, float)
+    points.flags.writeable = False
+    return points
 
 
 def _with_somersault(rng: np.random.Generator, spec: RodSpec) -> RodSpec:
@@ -200,18 +215,19 @@ def random_three_rods(
     gold rod does not cost the teal and violet ones their plans)."""
     cfg = config or RandomThreeRodsConfig()
     rods = [_feasible_rod(rng, k, cfg) for k in range(len(ROD_SPECS))]
-    target = rods[0].props[-1]
+    template = _template()
     return replace(
-        rods[0],
-        name="three_rods_random",
-        bodies=tuple(r.bodies[0] for r in rods),
-        props=(*(r.props[0] for r in rods), target),
-    )
+        template, bodies=tuple(body for body, _ in rods),
+        props=(*(ball for _, ball in rods), template.props[-1]),
+        control_frequency=cfg.control_frequency, resolved=True,
+    )  # fmt: skip
 
 
-def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) -> Scenario:
-    """A resolved scene of rod ``k`` alone (with its ball and the target) within the limits;
-    model objects are built only for the rod kept."""
+def _feasible_rod(
+    rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig
+) -> tuple[Body, Prop]:
+    """Rod ``k``'s body and ball, drawn until within the limits; model objects are built
+    only for the rod kept."""
     share = cfg.demand_share
     for _ in range(MAX_DRAWS):
         candidate = _candidate(rng, k, cfg)
@@ -219,7 +235,7 @@ def _feasible_rod(rng: np.random.Generator, k: int, cfg: RandomThreeRodsConfig) 
         if bound is None or candidate is None:
             continue
         if bound[0] <= share * cfg.force_limit and bound[1] <= share * cfg.torque_limit:
-            return _rod_scene(candidate, cfg)
+            return _rod_body(candidate, cfg), candidate.ball
     raise RuntimeError(
         f"no feasible {ROD_SPECS[k].name} in {MAX_DRAWS} draws: narrow the ranges or raise "
         "the limits"
@@ -251,6 +267,8 @@ class _Candidate:
     path: RodPath
     ball: Prop
     nails: np.ndarray
+    tip: tuple[float, float, float]
+    """Where the tip starts, as ``course_features`` computes it from the built body."""
     times: list[float]
     fixed: frozenset[int]
     weights: list[float]
@@ -282,22 +300,44 @@ def _candidate_of(
     fixed = {path.pierce: spec.pierce_time, n - 2: hit, n - 1: hit + EMBED_DURATION}
     nails = path.nails.copy()
     nails[path.pierce] = ball.position_at(spec.pierce_time)
-    distances = np.linalg.norm(np.diff(np.vstack((_tip(path), nails)), axis=0), axis=1)
+    tip = _tip(path)
+    # |nail_j - nail_{j-1}| in plain floats (numpy's norm sums the squares in this order)
+    rows = [tip, *nails.tolist()]
+    distances = [
+        math.sqrt((bx - ax) * (bx - ax) + (by - ay) * (by - ay) + (bz - az) * (bz - az))
+        for (ax, ay, az), (bx, by, bz) in zip(rows[:-1], rows[1:], strict=True)
+    ]
     somersault = spec.somersault_sample if path.turn is not None else None
     weights = [spec.somersault_weight if j == somersault else 1.0 for j in range(n)]
-    routed = resolve_goal_times(
-        [None if j not in fixed else grid_time(fixed[j], f) for j in range(n)],
-        [j in fixed for j in range(n)], distances.tolist(), weights,
-    )  # fmt: skip
-    times = [grid_time(float(t), f) for t in routed]
+    anchors = [(j, grid_time(fixed[j], f)) for j in sorted(fixed)]
+    times = [grid_time(t, f) for t in _route(distances, weights, anchors)]
     if any(b <= a for a, b in zip([0.0, *times], times, strict=False)):
         return None
-    return _Candidate(path, ball, nails, times, frozenset(fixed), weights, somersault, f)
+    return _Candidate(path, ball, nails, tip, times, frozenset(fixed), weights, somersault, f)
 
 
-def _tip(path: RodPath) -> np.ndarray:
+def _route(
+    distances: list[float], weights: list[float], anchors: list[tuple[int, float]]
+) -> list[float]:
+    """``resolve_goal_times`` of goals whose time-critical ones are ``anchors`` (index, time;
+    increasing, the last goal last): its arithmetic without its per-goal checks, which cost
+    as much as the rest of the routing and which a drawn rod passes by construction (its
+    course lengths are positive; the times are checked on the grid afterwards)."""
+    out: list[float] = []
+    first, t0 = 0, 0.0
+    for last, t in anchors:
+        if last > first:
+            share = np.divide(distances[first : last + 1], weights[first : last + 1])
+            out += (t0 + (t - t0) * _cumulative_fractions(share))[:-1].tolist()
+        out.append(t)
+        first, t0 = last + 1, t
+    return out
+
+
+def _tip(path: RodPath) -> tuple[float, float, float]:
     """The tip's start, as ``course_features`` computes it from the built body."""
-    return np.asarray(_vec3(path.com_start)) + np.asarray(quat.rotate(path.start, TIP))
+    (x, y, z), (dx, dy, dz) = _vec3(path.com_start), quat.rotate(path.start, TIP)
+    return x + dx, y + dy, z + dz
 
 
 def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | None]]:
@@ -309,23 +349,41 @@ def _orientation_goals(c: _Candidate) -> list[tuple[quat.Quat | None, Vec3 | Non
 
 def _candidate_bound(c: _Candidate, k: int) -> tuple[float, float] | None:
     """:func:`rod_bound` of the rod's scene, from its arrays (the same floats)."""
-    rest = np.zeros(3)
+    rest = _REST
     spin = spin_feature(c.path.start, _orientation_goals(c), c.times, (rest, rest), c.frequency)
     if spin is None:
         return None
-    launch = np.asarray(_vec3(c.path.launch))
-    point = point_feature(c.times, _tip(c.path), c.nails, launch, rest)
-    gravity = float(np.linalg.norm(_template().gravity))
+    point = point_feature(c.times, np.asarray(c.tip), c.nails, c.path.launch, rest)
     return demand_bound(
-        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA,
-        arm=float(np.linalg.norm(TIP)), gravity=gravity,
+        (point, spin), BOUND_FACTORS[k], mass=ROD_MASS, inertia=ROD_INERTIA, arm=TIP_ARM,
+        gravity=_gravity(),
     )  # fmt: skip
+
+
+_REST = np.zeros(3)
+_REST.flags.writeable = False
+TIP_ARM = float(np.linalg.norm(TIP))
+"""The tracked point's distance from the centre of mass (``body_bound``'s ``arm``)."""
+
+
+@lru_cache(maxsize=1)
+def _gravity() -> float:
+    return float(np.linalg.norm(_template().gravity))
 
 
 def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
     """The rod's resolved scene built straight from its path: what ``rod_entries``, the parser
     and ``resolve_scenario`` make of it up to their 12-digit rounding (tested), at a fraction
     of their cost (the field checks and dict round trips were half of a draw)."""
+    template = _template()
+    return replace(
+        template, bodies=(_rod_body(c, cfg),), props=(c.ball, template.props[-1]),
+        control_frequency=c.frequency, resolved=True,
+    )  # fmt: skip
+
+
+def _rod_body(c: _Candidate, cfg: RandomThreeRodsConfig) -> Body:
+    """The body of :func:`_rod_scene` (the draws assemble one scene of the three)."""
     spec, rows = c.path.spec, c.nails.tolist()
     goals = tuple(
         Goal(
@@ -340,17 +398,12 @@ def _rod_scene(c: _Candidate, cfg: RandomThreeRodsConfig) -> Scenario:
         )  # fmt: skip
         for j, (orientation, relative) in enumerate(_orientation_goals(c))
     )
-    body = Body(
+    return Body(
         name=spec.name, shape="rod", size=(ROD_LENGTH, ROD_RADIUS), mass=ROD_MASS,
         position=_vec3(c.path.com_start), orientation=c.path.start,
         linear_velocity=_vec3(c.path.launch), color=spec.color,
         force_limit=float(cfg.force_limit), torque_limit=float(cfg.torque_limit), goals=goals,
         end_velocity=(0.0, 0.0, 0.0), end_angular_velocity=(0.0, 0.0, 0.0), collisions=False,
-    )  # fmt: skip
-    template = _template()
-    return replace(
-        template, bodies=(body,), props=(c.ball, template.props[-1]),
-        control_frequency=c.frequency, resolved=True,
     )  # fmt: skip
 
 
