@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["allocate_course_durations", "resolve_goal_times"]
+__all__ = ["allocate_course_durations", "cumulative_fractions", "resolve_goal_times"]
 
 
 def _finite_positive(values: np.ndarray, name: str, *, allow_zero: bool) -> None:
@@ -25,7 +25,7 @@ def _finite_positive(values: np.ndarray, name: str, *, allow_zero: bool) -> None
             raise ValueError(f"{name}[{i}] must be {bound}, got {v!r}")
 
 
-def _cumulative_fractions(share: np.ndarray) -> np.ndarray:
+def cumulative_fractions(share: np.ndarray) -> np.ndarray:
     """Fractions of the segment elapsed at each goal; the last is exactly 1."""
     cumulative = np.cumsum(share) / share.sum()
     cumulative[-1] = 1.0
@@ -113,7 +113,7 @@ def resolve_goal_times(
                 resolved[i] = t
             else:
                 share = np.asarray(seg_d, dtype=float) / np.asarray(seg_w, dtype=float)
-                elapsed = (t - anchor_time) * _cumulative_fractions(share)
+                elapsed = (t - anchor_time) * cumulative_fractions(share)
                 resolved[list(segment)] = anchor_time + elapsed
                 resolved[i] = t
             anchor_index, anchor_time = i, float(t)

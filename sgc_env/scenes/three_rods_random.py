@@ -31,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 
 from sgc_env.paper import quaternion as quat
-from sgc_env.paper.routing import _cumulative_fractions
+from sgc_env.paper.routing import cumulative_fractions
 from sgc_env.scenario import Body, Goal, Prop, Scenario, scenario_from_dict
 from sgc_env.scenario.demand import inertia_diagonal
 from sgc_env.scenario.model import Vec3, grid_time
@@ -328,7 +328,7 @@ def _route(
     for last, t in anchors:
         if last > first:
             share = np.divide(distances[first : last + 1], weights[first : last + 1])
-            out += (t0 + (t - t0) * _cumulative_fractions(share))[:-1].tolist()
+            out += (t0 + (t - t0) * cumulative_fractions(share))[:-1].tolist()
         out.append(t)
         first, t0 = last + 1, t
     return out
