@@ -57,9 +57,11 @@ def test_shapes_and_one_log_std_per_action_component() -> None:
     assert np.allclose(std, np.exp(policy.log_std_init) * gain.ravel(), rtol=1e-5)
 
 
-def test_it_is_the_single_body_net_applied_per_body() -> None:
-    three = _model(RANDOM_ID).policy
-    one = _model("SGCRod-v0").policy
+@pytest.mark.parametrize("skip", [False, True])
+def test_it_is_the_single_body_net_applied_per_body(skip: bool) -> None:
+    three = _model(RANDOM_ID, skip=skip).policy
+    one = _model("SGCRod-v0", skip=skip).policy
+    assert three.action_net.linear.in_features == 16 + BODY_FEATURES * skip
     shared = {k: v for k, v in three.state_dict().items() if k.startswith(SHARED)}
     assert shared and all(v.shape == one.state_dict()[k].shape for k, v in shared.items())
     one.load_state_dict(shared, strict=False)
@@ -134,6 +136,7 @@ def test_the_recipe_names_the_policy_and_the_current_random_id() -> None:
     hp = load_hyperparams("ppo", RANDOM_ID, RECIPE)
     assert hp.policy is PerBodyPolicy and hp.n_envs == 64
     assert hp.algo_kwargs["policy_kwargs"]["gains_env"] == RANDOM_ID
+    assert hp.algo_kwargs["policy_kwargs"]["skip"] is True
     with pytest.raises(ValueError, match="features_extractor_class must be ScheduleFeatures"):
         from baselines.agents.features import StandardizeObservation
 

@@ -88,16 +88,24 @@ def _mlp(sizes: list[int], activation: type[nn.Module]) -> nn.Sequential:
 
 
 class PerBodyExtractor(nn.Module):
-    """The shared per-body MLPs: ``(batch, n * 33)`` features to ``(batch, n * latent)``."""
+    """The shared per-body MLPs: ``(batch, n * 33)`` features to ``(batch, n * latent)``;
+    with ``skip`` the actor's latent also carries the body's features (why: a fixed linear law
+    on them meets every three-rod goal, docs/agents.md, so the head can start from one)."""
 
     def __init__(
-        self, n_bodies: int, pi: list[int], vf: list[int], activation: type[nn.Module]
+        self,
+        n_bodies: int,
+        pi: list[int],
+        vf: list[int],
+        activation: type[nn.Module],
+        skip: bool = False,
     ) -> None:
         super().__init__()
         self.n_bodies = n_bodies
+        self.skip = skip and bool(pi)
         self.policy_net = _mlp([BODY_FEATURES, *pi], activation)
         self.value_net = _mlp([BODY_FEATURES, *vf], activation)
-        self.latent_pi = pi[-1] if pi else BODY_FEATURES
+        self.latent_pi = (pi[-1] + BODY_FEATURES * self.skip) if pi else BODY_FEATURES
         self.latent_vf = vf[-1] if vf else BODY_FEATURES
         self.latent_dim_pi = n_bodies * self.latent_pi
         self.latent_dim_vf = n_bodies * self.latent_vf
@@ -109,7 +117,11 @@ class PerBodyExtractor(nn.Module):
         return self.forward_actor(features), self.forward_critic(features)
 
     def forward_actor(self, features: th.Tensor) -> th.Tensor:
-        return self.policy_net(self._bodies(features)).flatten(start_dim=1)
+        bodies = self._bodies(features)
+        latent = self.policy_net(bodies)
+        if self.skip:  # the head also reads the features: a linear law is one layer away
+            latent = th.cat([latent, bodies], dim=-1)
+        return latent.flatten(start_dim=1)
 
     def forward_critic(self, features: th.Tensor) -> th.Tensor:
         return self.value_net(self._bodies(features)).flatten(start_dim=1)
@@ -138,6 +150,7 @@ class PerBodyPolicy(ActorCriticPolicy):
 
     ``gains_env``: the env id whose bodies set the action gains at construction (None: gain 1,
     no hover, ``SGCRod-v0``'s scale without gravity); ``bind_env`` resets them for another env.
+    ``skip``: the action head reads the body's features beside the last hidden layer.
     The features extractor must be :class:`ScheduleFeatures` (the default here). The action
     noise's log std is shared per action component across bodies (6 parameters) and, like the
     mean, in acceleration units (``log_std_init=-3``: 5 m/s^2 and 5 rad/s^2 on every scene).
@@ -150,6 +163,7 @@ class PerBodyPolicy(ActorCriticPolicy):
         lr_schedule: Any,
         *args: Any,
         gains_env: str | None = None,
+        skip: bool = False,
         **kwargs: Any,
     ) -> None:
         kwargs.setdefault("features_extractor_class", ScheduleFeatures)
@@ -158,6 +172,7 @@ class PerBodyPolicy(ActorCriticPolicy):
         if kwargs.get("use_sde"):
             raise ValueError("PerBodyPolicy: use_sde is not supported")
         self.gains_env = gains_env
+        self.skip = skip
         n = int(np.prod(action_space.shape or (0,))) // BODY_ACTIONS
         box = isinstance(action_space, gym.spaces.Box)
         if not box or n < 1 or action_space.shape != (BODY_ACTIONS * n,):
@@ -176,7 +191,7 @@ class PerBodyPolicy(ActorCriticPolicy):
 
     def _get_constructor_parameters(self) -> dict[str, Any]:
         data = super()._get_constructor_parameters()
-        data["gains_env"] = self.gains_env
+        data.update(gains_env=self.gains_env, skip=self.skip)
         return data
 
     def _build_mlp_extractor(self) -> None:
@@ -188,7 +203,7 @@ class PerBodyPolicy(ActorCriticPolicy):
         arch = self.net_arch
         pi, vf = (arch["pi"], arch["vf"]) if isinstance(arch, dict) else (arch, arch)
         self.mlp_extractor = PerBodyExtractor(  # type: ignore[assignment]
-            self.n_bodies, list(pi), list(vf), self.activation_fn
+            self.n_bodies, list(pi), list(vf), self.activation_fn, self.skip
         )
 
     def _build(self, lr_schedule: Any) -> None:
