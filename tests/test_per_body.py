@@ -4,6 +4,7 @@ a scene with other limits."""
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 
 import gymnasium as gym
@@ -130,6 +131,17 @@ def test_a_saved_model_flies_the_paper_scene_with_that_scenes_gains(tmp_path: Pa
     assert bound["goals_met"] >= 57 and bound["n_goals"] == 58
     unbound = evaluate(model, PAPER_ID, 1, 0).summary  # still the random family's gains
     assert unbound["goals_met"] < bound["goals_met"]
+    # an id renamed since: a warning, and the file's own gains, re-bound to the env
+    with zipfile.ZipFile(path) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    members["data"] = members["data"].replace(RANDOM_ID.encode(), b"SGCRenamed-v9")
+    renamed = tmp_path / "renamed.zip"
+    with zipfile.ZipFile(renamed, "w") as archive:
+        for name, blob in members.items():
+            archive.writestr(name, blob)
+    with pytest.warns(UserWarning, match="'SGCRenamed-v9' is not registered"):
+        again = load_sb3_model(renamed, env=gym.make(PAPER_ID))
+    assert th.equal(again.policy.action_net.gain, loaded.policy.action_net.gain)
 
 
 def test_the_recipe_names_the_policy_and_the_current_random_id() -> None:

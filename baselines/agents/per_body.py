@@ -23,6 +23,7 @@ the other policy kwargs) and again, for the env a saved model is loaded on, by
 
 from __future__ import annotations
 
+import warnings
 from functools import partial
 from typing import Any
 
@@ -179,9 +180,14 @@ class PerBodyPolicy(ActorCriticPolicy):
             raise ValueError(f"PerBodyPolicy needs a Box of 6 actions per body, got {action_space}")
         self.n_bodies = n
         self._initial_gains = (np.ones((n, BODY_ACTIONS)), np.zeros((n, BODY_ACTIONS)))
-        if gains_env is not None:
-            import sgc_env  # noqa: F401  (registers the ids)
+        import sgc_env  # noqa: F401  (registers the ids)
 
+        if gains_env is not None and gains_env not in gym.registry:
+            # a saved model whose id was renamed still loads: its gains come back from the
+            # file's buffers, and the loader re-binds them to the env it is loaded on
+            warnings.warn(f"PerBodyPolicy: gains_env {gains_env!r} is not registered; unit "
+                          "gains until bind_env or the saved buffers set them", stacklevel=2)
+        elif gains_env is not None:
             env = gym.make(gains_env)
             try:
                 self._initial_gains = body_gains(env)
