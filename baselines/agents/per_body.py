@@ -185,8 +185,11 @@ class PerBodyPolicy(ActorCriticPolicy):
         if gains_env is not None and gains_env not in gym.registry:
             # a saved model whose id was renamed still loads: its gains come back from the
             # file's buffers, and the loader re-binds them to the env it is loaded on
-            warnings.warn(f"PerBodyPolicy: gains_env {gains_env!r} is not registered; unit "
-                          "gains until bind_env or the saved buffers set them", stacklevel=2)
+            warnings.warn(
+                f"PerBodyPolicy: gains_env {gains_env!r} is not registered; unit "
+                "gains until bind_env or the saved buffers set them",
+                stacklevel=2,
+            )
         elif gains_env is not None:
             env = gym.make(gains_env)
             try:
