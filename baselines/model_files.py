@@ -66,11 +66,13 @@ def allowed_classes() -> dict[str, type]:
     from stable_baselines3.td3 import policies as td3
 
     from baselines.agents.features import ACTIVATIONS, StandardizeObservation
+    from baselines.agents.per_body import PerBodyPolicy
     from baselines.agents.schedule_features import ScheduleFeatures
 
     classes: list[type] = [
         policies.ActorCriticPolicy, policies.ActorCriticCnnPolicy,
-        policies.MultiInputActorCriticPolicy, sac.SACPolicy, sac.CnnPolicy, sac.MultiInputPolicy,
+        policies.MultiInputActorCriticPolicy, PerBodyPolicy, sac.SACPolicy, sac.CnnPolicy,
+        sac.MultiInputPolicy,
         td3.TD3Policy, td3.CnnPolicy, td3.MultiInputPolicy,
         torch_layers.FlattenExtractor, torch_layers.NatureCNN, torch_layers.CombinedExtractor,
         StandardizeObservation, ScheduleFeatures,
@@ -318,7 +320,7 @@ def load_sb3_model(
     else:
         objects = safe_custom_objects(data, env, name, algorithm)
     try:
-        return algorithm.load(io.BytesIO(blob), env=env, device=device, custom_objects=objects)
+        model = algorithm.load(io.BytesIO(blob), env=env, device=device, custom_objects=objects)
     except pickle.UnpicklingError as exc:
         first = str(exc).splitlines()[0]
         raise _fail(name, "its weights hold objects other than tensors, refused by torch's "
@@ -326,3 +328,7 @@ def load_sb3_model(
     except (RuntimeError, KeyError, TypeError, AssertionError, ValueError) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise _fail(name, f"does not load as a {algo} for this env: {first}") from None
+    bind = getattr(model.policy, "bind_env", None)
+    if env is not None and bind is not None:  # PerBodyPolicy: the env's action gains
+        bind(env)
+    return model

@@ -404,6 +404,7 @@ SHIPPED_SCORES = {
     "ppo_dagger_SGCIntercept-v0.zip": ("SGCIntercept-v0", 1.0),
     "ppo_schedule_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
     "ppo_schedule_SGCRod-v0.zip": ("SGCRod-v0", 0.9),
+    "ppo_perbody_SGCThreeRodsRandom-v2.zip": ("SGCThreeRodsRandom-v2", 0.85),
 }
 
 

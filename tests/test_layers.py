@@ -93,6 +93,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
      "baselines.tracking", "baselines.dynamic_constraints", "baselines.shipped"),
     ("baselines.atomic_files", "baselines.value_types", "baselines.env_kwargs",
      "baselines.agents.features", "baselines.agents.schedule_features"),
+    ("baselines.agents.per_body",),
     ("baselines.normalization", "baselines.model_files"),
     ("baselines.env_model",),
     ("baselines.actuation",),

@@ -42,7 +42,7 @@ class Hyperparams:
     env_id: str
     algo: str
     n_timesteps: int
-    policy: str
+    policy: str | type  # an SB3 alias, or a class of this project (_policy_class)
     n_envs: int = 1
     normalize: bool = False
     normalize_kwargs: dict[str, Any] = field(default_factory=dict)
@@ -76,6 +76,15 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
 
         return HerReplayBuffer
     raise ValueError(f"{field_name}: name {dotted!r} is not allowed (activations: {ACTIVATIONS})")
+
+
+def _policy_class(name: str) -> str | type:
+    """SB3's policy aliases stay strings; ``PerBodyPolicy`` is this project's class."""
+    if name == "PerBodyPolicy":
+        from baselines.agents.per_body import PerBodyPolicy
+
+        return PerBodyPolicy
+    return name
 
 
 def _dotted(node: ast.AST) -> str | None:
@@ -242,7 +251,7 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         env_id=env_id,
         algo=algo,
         n_timesteps=n_timesteps,
-        policy=str(entry["policy"]),
+        policy=_policy_class(entry["policy"]),
         n_envs=n_envs,
         normalize=normalize,
         normalize_kwargs=normalize_kwargs,
