@@ -38,18 +38,20 @@ def test_every_recipe_resolves_on_its_envs() -> None:
 
 
 
-def test_the_timed_rod_recipe_resolves_with_a_fixed_step_budget() -> None:
-    """benchmarks/fast_recipes.yml is the 10-seed timed sweep: a fixed number of steps (so a
-    seed gives one model), hyperparameters that resolve on the rod."""
+def test_the_timed_recipes_resolve_with_a_fixed_step_budget() -> None:
+    """benchmarks/fast_recipes*.yml are the 10-seed timed sweeps: a fixed number of steps (so
+    a seed gives one model), hyperparameters that resolve on their id."""
     from baselines.agents.hyperparams import load_hyperparams
     from baselines.benchmark.grid import load_recipes
 
-    recipes = load_recipes(ROOT / "benchmarks" / "fast_recipes.yml")
-    assert [r.envs for r in recipes] == [("SGCRod-v0",)]
-    for recipe in recipes:
-        assert isinstance(recipe.timesteps, int) and recipe.timesteps > 0
-        hp = load_hyperparams(recipe.algo, "SGCRod-v0", recipe.hyperparams)
-        assert hp.n_envs == 64 and hp.algo_kwargs["batch_size"] == 1024
+    timed = (("fast_recipes.yml", "SGCRod-v0"), ("fast_recipes_point.yml", "SGCPoint-v0"))
+    for name, env_id in timed:
+        recipes = load_recipes(ROOT / "benchmarks" / name)
+        assert [r.envs for r in recipes] == [(env_id,)]
+        for recipe in recipes:
+            assert isinstance(recipe.timesteps, int) and recipe.timesteps > 0
+            hp = load_hyperparams(recipe.algo, env_id, recipe.hyperparams)
+            assert hp.n_envs == 64 and hp.algo_kwargs["batch_size"] == 1024
 
 def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
     from baselines.agents.train import TrainConfig, train
