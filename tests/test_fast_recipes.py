@@ -37,6 +37,22 @@ def test_every_recipe_resolves_on_its_envs() -> None:
                 assert hp.n_envs >= 16 and hp.n_envs * hp.algo_kwargs["n_steps"] >= 2048
 
 
+
+def test_the_timed_recipes_resolve_with_a_fixed_step_budget() -> None:
+    """benchmarks/fast_recipes*.yml are the 10-seed timed sweeps: a fixed number of steps (so
+    a seed gives one model), hyperparameters that resolve on their id."""
+    from baselines.agents.hyperparams import load_hyperparams
+    from baselines.benchmark.grid import load_recipes
+
+    timed = (("fast_recipes.yml", "SGCRod-v0"), ("fast_recipes_point.yml", "SGCPoint-v0"))
+    for name, env_id in timed:
+        recipes = load_recipes(ROOT / "benchmarks" / name)
+        assert [r.envs for r in recipes] == [(env_id,)]
+        for recipe in recipes:
+            assert isinstance(recipe.timesteps, int) and recipe.timesteps > 0
+            hp = load_hyperparams(recipe.algo, env_id, recipe.hyperparams)
+            assert hp.n_envs == 64 and hp.algo_kwargs["batch_size"] == 1024
+
 def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
     from baselines.agents.train import TrainConfig, train
 
@@ -57,3 +73,22 @@ def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
 def test_seed_table_names_a_folder_that_is_not_a_run(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="not a finished run"):
         _seed_table().seed_row(tmp_path, episodes=1, seed=20_000)
+
+
+def test_seed_table_reads_a_benchmark_score_only_for_the_seeds_asked(tmp_path: Path) -> None:
+    """--scored takes the final score of a `sgc benchmark` run's result.json, never a score
+    measured on other held-out seeds or episodes."""
+    import json
+
+    (tmp_path / "final_model.zip").write_bytes(b"")
+    (tmp_path / "config.json").write_text(json.dumps({
+        "env_id": "SGCRod-v0", "seed": 4, "timesteps": 1000, "wall_time_s": 12.3,
+        "learn_time_s": 10.0}))  # fmt: skip
+    final = {"goals_met": 121, "n_goals": 150, "success_rate": 121 / 150}
+    (tmp_path / "result.json").write_text(json.dumps({
+        "spec": {"eval_episodes": 50, "test_seed": 20_000},
+        "scores": {"final": final, "best": {"goals_met": 0, "n_goals": 150, "success_rate": 0}}}))
+    row = _seed_table().seed_row(tmp_path, episodes=50, seed=20_000, scored=True)
+    assert (row["seed"], row["goals_met"], row["wall_time_s"]) == (4, 121, 12.3)
+    with pytest.raises(ValueError, match="not 50 from 30000"):
+        _seed_table().seed_row(tmp_path, episodes=50, seed=30_000, scored=True)
