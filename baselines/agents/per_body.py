@@ -36,6 +36,7 @@ from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
 from baselines.agents.schedule_features import TRACK_FEATURES, ScheduleFeatures
+from baselines.env_model import EnvModel
 
 __all__ = [
     "BODY_ACTIONS",
@@ -71,12 +72,12 @@ def body_gains(env: Any) -> tuple[np.ndarray, np.ndarray]:
             f"PerBodyPolicy needs {BODY_ACTIONS} actions per body (force and torque); "
             f"{type(base).__name__} has action shape {shape} for {n} bodies"
         )
-    inertia = np.asarray(base.body_inertia, dtype=np.float64).max(axis=1)
-    gravity = np.asarray(scenario.gravity, dtype=np.float64)
+    model = EnvModel.from_env(base)
+    gravity = np.asarray(model.gravity, dtype=np.float64)
     gain, offset = np.zeros((n, BODY_ACTIONS)), np.zeros((n, BODY_ACTIONS))
-    for i, body in enumerate(scenario.bodies):
+    for i, body in enumerate(model.bodies):
         gain[i, :3] = REFERENCE_ACCELERATION * body.mass / body.force_limit
-        gain[i, 3:] = REFERENCE_ACCELERATION * inertia[i] / body.torque_limit
+        gain[i, 3:] = REFERENCE_ACCELERATION * max(body.inertia) / body.torque_limit
         offset[i, :3] = -body.mass * gravity / body.force_limit
     return gain, offset
 
