@@ -84,8 +84,9 @@ def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str |
         f"- **Training steps**: {entry['timesteps']:,} RL env steps"
         + (" (behaviour cloning and DAgger rollouts not counted)" if entry["demonstrations"]
            else ""),  # fmt: skip
-        f"- **Wall clock**: {entry['wall_time_s']:.0f} s; machine: not recorded when it was "
-        "trained (the project's shared CPU machine)",
+        f"- **Wall clock**: {entry['wall_time_s']:.0f} s; machine: "
+        + str(entry.get("machine") or "not recorded when it was trained (the project's shared "
+              "CPU machine)"),  # fmt: skip
         f"- **File**: `{entry['file']}`"
         + (" with its `VecNormalize` statistics (JSON)"
            if _has_json_statistics(CHECKPOINTS / str(entry["file"])) else ""),  # fmt: skip
