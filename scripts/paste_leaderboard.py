@@ -5,7 +5,10 @@ The README and docs/agents.md carry the leaderboard that ``sgc benchmark`` wrote
 ``<!-- leaderboard:begin -->`` and ``<!-- leaderboard:end -->``, so a rerun of the benchmark
 updates them with one command::
 
-    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md README.md docs/agents.md
+    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md docs/agents.md
+
+``--marker NAME`` pastes between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` instead, so
+one document can carry several leaderboards (the equal wall-clock one is ``budget-leaderboard``).
 """
 
 from __future__ import annotations
@@ -13,7 +16,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-BEGIN, END = "<!-- leaderboard:begin -->", "<!-- leaderboard:end -->"
+DEFAULT_MARKER = "leaderboard"
+
+
+def markers(name: str) -> tuple[str, str]:
+    """The begin and end lines of the marker pair called ``name``."""
+    return f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
 
 
 def leaderboard_body(text: str) -> str:
@@ -25,23 +33,26 @@ def leaderboard_body(text: str) -> str:
     return "\n".join(body).strip()
 
 
-def paste(document: str, body: str, where: str) -> str:
-    if document.count(BEGIN) != 1 or document.count(END) != 1:
-        raise ValueError(f"{where}: needs exactly one {BEGIN} and one {END} line")
-    head, rest = document.split(BEGIN)
-    _, tail = rest.split(END)
-    return f"{head}{BEGIN}\n{body}\n{END}{tail}"
+def paste(document: str, body: str, where: str, marker: str = DEFAULT_MARKER) -> str:
+    begin, end = markers(marker)
+    if document.count(begin) != 1 or document.count(end) != 1:
+        raise ValueError(f"{where}: needs exactly one {begin} and one {end} line")
+    head, rest = document.split(begin)
+    _, tail = rest.split(end)
+    return f"{head}{begin}\n{body}\n{end}{tail}"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("leaderboard", type=Path, help="leaderboard.md written by sgc benchmark")
     parser.add_argument("documents", type=Path, nargs="+", help="markdown files with the markers")
+    parser.add_argument("--marker", default=DEFAULT_MARKER,
+                        help="paste between <!-- MARKER:begin --> and <!-- MARKER:end -->")  # fmt: skip
     args = parser.parse_args()
     body = leaderboard_body(args.leaderboard.read_text())
     for doc in args.documents:
         try:
-            doc.write_text(paste(doc.read_text(), body, str(doc)))
+            doc.write_text(paste(doc.read_text(), body, str(doc), args.marker))
         except ValueError as exc:
             parser.error(str(exc))
         print(f"pasted {args.leaderboard} into {doc}")

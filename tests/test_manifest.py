@@ -16,6 +16,7 @@ from baselines.benchmark.manifest import (  # noqa: E402
     check_manifest,
     load_manifest,
     ship_model,
+    steps_trained,
     write_entry,
 )
 from baselines.cli import main as cli  # noqa: E402
@@ -103,3 +104,12 @@ def test_shipped_model_carries_its_normalisation(tmp_path: Path) -> None:
     bare = evaluate(str(alone / "tiny.zip"), "SGCPoint-v0", 1, 20_000).summary
     assert shipped["position_error_mean"] == in_run["position_error_mean"]
     assert bare["position_error_mean"] != in_run["position_error_mean"]
+
+
+def test_a_budget_run_ships_the_steps_it_learned_from_not_its_cap() -> None:
+    budget = {"timesteps": 500_000, "steps_reached": 503_808, "steps_learned": 503_808}
+    assert steps_trained(budget) == 503_808
+    cut = {"timesteps": 10_000_000, "steps_reached": 36_864, "steps_learned": 32_768}
+    assert steps_trained(cut) == 32_768
+    assert steps_trained({"timesteps": 1_253_376}) == 1_253_376  # a run without a budget
+    assert steps_trained({"timesteps": 0}) == 0  # behaviour cloning only

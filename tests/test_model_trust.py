@@ -261,8 +261,8 @@ def test_safe_and_trusted_loading_predict_alike(clean: Path) -> None:
 def test_shipped_models_hold_no_pickle_beside_them() -> None:
     assert not list(SHIPPED.glob("*.pkl"))
     assert sorted(p.name for p in SHIPPED.glob("*.vecnormalize.json")) == [
-        "ppo_rod300_SGCRod-v0.vecnormalize.json", "ppo_schedule_SGCPoint-v0.vecnormalize.json",
-        "ppo_schedule_SGCRod-v0.vecnormalize.json",
+        "ppo_point500k_SGCPoint-v0.vecnormalize.json", "ppo_rod300_SGCRod-v0.vecnormalize.json",
+        "ppo_schedule_SGCPoint-v0.vecnormalize.json", "ppo_schedule_SGCRod-v0.vecnormalize.json",
     ]  # fmt: skip
 
 

@@ -137,9 +137,14 @@ def ship_model(
     entry = {
         "file": target.name, "env_id": config["env_id"], "algo": config["algo"],
         "demonstrations": train_config.get("init") == "bc",
-        "timesteps": int(config.get("timesteps") or 0), "seed": int(config["seed"]),
+        "timesteps": steps_trained(config), "seed": int(config["seed"]),
         "wall_time_s": round(float(config["wall_time_s"]), 1), "command": command,
         "result": held_out_result(target, config["env_id"], episodes, seed, env_kwargs),
     }  # fmt: skip
     write_entry(entry, root)
     return entry
+
+
+def steps_trained(config: Mapping[str, Any]) -> int:
+    """The env steps the model learned from: under a time budget ``timesteps`` is only the cap."""
+    return int(config.get("steps_learned") or config.get("timesteps") or 0)
