@@ -46,8 +46,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("leaderboard", type=Path, help="leaderboard.md written by sgc benchmark")
     parser.add_argument("documents", type=Path, nargs="+", help="markdown files with the markers")
-    parser.add_argument("--marker", default=DEFAULT_MARKER,
-                        help="paste between <!-- MARKER:begin --> and <!-- MARKER:end -->")  # fmt: skip
+    parser.add_argument(
+        "--marker", default=DEFAULT_MARKER,
+        help="paste between <!-- MARKER:begin --> and <!-- MARKER:end -->",
+    )  # fmt: skip
     args = parser.parse_args()
     body = leaderboard_body(args.leaderboard.read_text())
     for doc in args.documents:
