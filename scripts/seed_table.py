@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from baselines.benchmark.manifest import held_out_result
+from baselines.benchmark.manifest import held_out_result, steps_trained
 
 
 def _benchmark_score(run: Path, episodes: int, seed: int) -> dict[str, Any]:
@@ -50,7 +50,7 @@ def seed_row(run: Path, episodes: int, seed: int, scored: bool = False) -> dict[
         result = held_out_result(model, config["env_id"], episodes, seed, env_kwargs)
     return {
         "run": str(run), "env_id": config["env_id"], "seed": config["seed"],
-        "steps": config["timesteps"], "wall_time_s": round(config["wall_time_s"], 1),
+        "steps": steps_trained(config), "wall_time_s": round(config["wall_time_s"], 1),
         "learn_time_s": round(config["learn_time_s"], 1),
         "goals_met": result["goals_met"], "n_goals": result["n_goals"],
         "success_rate": result["success_rate"], "result": result,
