@@ -93,3 +93,21 @@ def test_seed_table_reads_a_benchmark_score_only_for_the_seeds_asked(tmp_path: P
     assert (row["seed"], row["goals_met"], row["wall_time_s"]) == (4, 121, 12.3)
     with pytest.raises(ValueError, match="not 50 from 30000"):
         _seed_table().seed_row(tmp_path, episodes=50, seed=30_000, scored=True)
+
+
+def test_the_raw_observation_rows_copy_their_ppo_rows_but_the_features() -> None:
+    """ppo_raw repeats each env's PPO row (the ablation's point); this keeps the copies aligned."""
+    import yaml
+
+    hp = ROOT / "benchmarks" / "hyperparams"
+    raw = yaml.safe_load((hp / "ppo_raw" / "ppo.yml").read_text())
+    for env_id, folder in (("SGCRod-v0", "ppo_rod300"), ("SGCPoint-v0", "ppo_rod_alive64")):
+        ppo = yaml.safe_load((hp / folder / "ppo.yml").read_text())[env_id]
+        copy = raw[env_id]
+        skip = {"n_timesteps", "policy_kwargs"}  # a budget cap; the features extractor
+        assert {k: v for k, v in copy.items() if k not in skip} == {
+            k: v for k, v in ppo.items() if k not in skip
+        }, env_id
+        assert "ScheduleFeatures" in ppo["policy_kwargs"]
+        assert copy["policy_kwargs"] == "dict(net_arch=[64, 64], log_std_init=-3.0)"
+        assert ppo["policy_kwargs"].startswith("dict(net_arch=[64, 64], log_std_init=-3.0, ")
