@@ -26,7 +26,7 @@ import numpy as np
 import sgc_env
 from baselines.episodes import EpisodeRecord, run_episode, run_episodes_batched
 from baselines.policies import Policy, make_policy, policy_label
-from sgc_env.envs.vector_env import make_vec
+from sgc_env.envs.vector.vector_env import make_vec
 from sgc_env.metrics import Tolerances
 
 __all__ = [

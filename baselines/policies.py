@@ -228,7 +228,7 @@ def _spaces_env(env: Any) -> Any:
     if not envs:
         raise ValueError(
             f"policy: {type(env).__name__} keeps its sub-envs out of reach; use the SGC batched "
-            "env (sgc_env.envs.vector_env.make_vec) or SyncVectorEnv"
+            "env (sgc_env.envs.vector.vector_env.make_vec) or SyncVectorEnv"
         )
     return envs[0]
 

@@ -56,9 +56,9 @@ for _id, (_entry, _kwargs) in _REGISTRY.items():
                 (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else ()
             ),
             vector_entry_point=(
-                "sgc_env.envs.vector_env:SGCGoalVectorEnv"
+                "sgc_env.envs.vector.vector_env:SGCGoalVectorEnv"
                 if _entry.startswith(_GOAL)
-                else "sgc_env.envs.vector_env:SGCVectorEnv"
+                else "sgc_env.envs.vector.vector_env:SGCVectorEnv"
             ),
         )
 

@@ -12,9 +12,9 @@ import pytest
 import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
-from sgc_env.envs import batch as batch_module
+from sgc_env.envs.vector import batch as batch_module
 from sgc_env.envs.rewards import REWARD_MODES
-from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
+from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
 SIZES = {"SGCThreeRodsRandom-v2": (2, 40), "SGCThreeRods-v1": (2, 45)}

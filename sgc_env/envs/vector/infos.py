@@ -15,8 +15,8 @@ import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
 
-from .batch_task import BatchTask
-from .task import GoalEvent
+from ..task import GoalEvent
+from .task import BatchTask
 
 __all__ = ["row_infos", "vector_infos"]
 

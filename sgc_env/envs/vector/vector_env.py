@@ -28,10 +28,10 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
+from ..goal_env import SGCGoalEnv
+from ..sgc_env import SGCEnv
 from .batch import Batch
-from .batch_infos import vector_infos
-from .goal_env import SGCGoalEnv
-from .sgc_env import SGCEnv
+from .infos import vector_infos
 
 __all__ = ["SGCGoalVectorEnv", "SGCVectorEnv", "batch_infos", "make_vec"]
 

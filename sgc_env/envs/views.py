@@ -1,0 +1,81 @@
+"""Observation views: what an env observes of its step record, one class per view.
+
+A view turns the step record (:mod:`.record`: per body the planner's block of doubles, the
+time, points, forces and torques), an (N, record) float64 array, into the (N, size) float32
+observations of N sub-envs at once; the single env is N = 1 and the batched env hands the
+array out as it is. Both envs run the same :meth:`ObservationView.observe`. ``SGCEnv(...,
+observation=...)`` picks a view by name (:data:`VIEWS`) or takes an instance; a new view is one
+subclass registered with :func:`observation_view`.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+
+from sgc_env.observation import ObservationLayout
+
+__all__ = ["OBS_BOUND", "VIEWS", "ObservationView", "PlannerView", "make_view", "observation_view"]
+
+OBS_BOUND = 1e5
+
+
+class ObservationView:
+    """One observation of a scene (module docstring); :meth:`bind` gives it the scene's layout
+    (body count and names) before the first :meth:`observe`."""
+
+    name = "custom"
+
+    def __init__(self) -> None:
+        self.layout = ObservationLayout(1)
+
+    def bind(self, layout: ObservationLayout) -> ObservationView:
+        """A copy of this view for a scene with ``layout``."""
+        view = object.__new__(type(self))
+        view.__dict__.update(self.__dict__)
+        view.layout = layout
+        return view
+
+    def space(self) -> gym.spaces.Box:
+        """The observation space of one sub-env."""
+        raise NotImplementedError
+
+    def observe(self, record: np.ndarray) -> np.ndarray:
+        """The observations (N, size) float32 of N sub-envs' step records (N, record)."""
+        raise NotImplementedError
+
+
+VIEWS: dict[str, type[ObservationView]] = {}
+
+
+def observation_view(cls: type[ObservationView]) -> type[ObservationView]:
+    """Register a view under its ``name`` (the ``observation=`` string that picks it)."""
+    VIEWS[cls.name] = cls
+    return cls
+
+
+@observation_view
+class PlannerView(ObservationView):
+    """The planner's observation: the record's first ``layout.size`` doubles as float32 (per
+    body state, goal data, deviations with their float32 residuals; then the time), laid out
+    by :class:`~sgc_env.observation.ObservationLayout`, bounds +-1e5."""
+
+    name = "planner"
+
+    def space(self) -> gym.spaces.Box:
+        return gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
+
+    def observe(self, record: np.ndarray) -> np.ndarray:
+        return record[:, : self.layout.size].astype(np.float32)
+
+
+def make_view(view: object) -> ObservationView:
+    """The view ``view`` names (one of :data:`VIEWS`), or ``view`` itself when it is one."""
+    if isinstance(view, ObservationView):
+        return view
+    if not isinstance(view, str) or view not in VIEWS:
+        raise ValueError(
+            f"observation: unknown view {view!r}; expected one of {list(VIEWS)} or a "
+            "sgc_env.envs.views.ObservationView instance"
+        )
+    return VIEWS[view]()
