@@ -7,7 +7,6 @@ Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium, each 
 from __future__ import annotations
 
 import gymnasium as gym
-from gymnasium.envs.registration import WrapperSpec
 
 from sgc_env.episode_steps import registered_steps
 from sgc_env.observation import ObservationLayout
@@ -27,7 +26,6 @@ __all__ = [
 
 _ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
 _GOAL = "sgc_env.envs.goal_env"
-_STEPS = "sgc_env.episode_steps"
 _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
     "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
@@ -39,9 +37,6 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
 
-_LENGTH_CHECK = WrapperSpec("EpisodeLengthCheck", f"{_STEPS}:EpisodeLengthCheck", {})
-_GOAL_REWARD = WrapperSpec("GoalRewardAccess", f"{_GOAL}:GoalRewardAccess", {})
-
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
         gym.register(
@@ -49,12 +44,10 @@ for _id, (_entry, _kwargs) in _REGISTRY.items():
             entry_point=_entry,
             kwargs=_kwargs,
             max_episode_steps=registered_steps(_kwargs),
-            # Gymnasium's make_vec refuses ids with additional wrappers, so SGCEnv ids check
-            # their episode length in the env itself (SGCEnv._check_length); the goal id needs
-            # GoalRewardAccess outermost and is batched with sgc_env.make_vec instead.
-            additional_wrappers=(
-                (_LENGTH_CHECK, _GOAL_REWARD) if _entry.startswith(_GOAL) else ()
-            ),
+            # No additional wrappers: Gymnasium's make_vec refuses ids that have them. Every
+            # env checks its episode length itself (SGCEnv.reset); the goal id's
+            # compute_reward is reached as env.unwrapped.compute_reward or through
+            # env.get_wrapper_attr("compute_reward") (SB3's HER does so).
             vector_entry_point=(
                 "sgc_env.envs.vector.vector_env:SGCGoalVectorEnv"
                 if _entry.startswith(_GOAL)

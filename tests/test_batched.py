@@ -13,7 +13,7 @@ import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
 from sgc_env.envs.vector import batch as batch_module
-from sgc_env.envs.rewards import REWARD_MODES
+from sgc_env.envs.rewards import REWARD_MODES, RewardMode, StepScore, effort
 from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
@@ -76,10 +76,10 @@ def run_pair(
     seed: int = 11,
     **kwargs: Any,
 ) -> int:
-    """Step ``make_vec(env_id, n)`` beside n ``gym.make(env_id)`` envs (reset with seed + i,
+    """Step ``gym.make_vec(env_id, n)`` (every id's vector entry point) beside n ``gym.make(env_id)`` envs (reset with seed + i,
     reset again on their own after an episode, as next-step autoreset does) and assert every
     output equal. Returns the number of autoresets."""
-    vec = make_vec(env_id, n, **kwargs)
+    vec = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", **kwargs)
     singles = [gym.make(env_id, **kwargs) for _ in range(n)]
     rng = np.random.default_rng(seed)
     experts = [_Expert() for _ in range(n)]
@@ -112,7 +112,7 @@ def run_pair(
                         twin.bit_generator.state = state
                         vflat = _row(vobs, i)
                         vflat = vflat["observation"] if isinstance(vflat, dict) else vflat
-                        twin_obs = apply_random_push(vec.envs[i], vflat, pushes, twin, tick)
+                        twin_obs = apply_random_push(vec.unwrapped.envs[i], vflat, pushes, twin, tick)
                         assert _same(twin_obs, pushed)
                         obs[i] = pushed
                     actions[i] = experts[i](env, obs[i], bool(fresh[i]))
@@ -147,6 +147,20 @@ def test_every_id_equals_single_envs_under_random_actions(env_id: str) -> None:
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1", "SGCInterceptRandom-v0"])
 def test_every_reward_mode_equals_single_envs(env_id: str, reward: str) -> None:
     assert run_pair(env_id, 2, 50, reward=reward, max_episode_steps=20) >= 2
+
+
+class _Upright(RewardMode):
+    """A reward of the caller's own: the time left to the first body's position goal, less
+    the effort (plain arithmetic, so it runs on floats and on arrays alike)."""
+
+    def reward(self, step: StepScore) -> Any:
+        _, _, left, _, _ = step.tracks[0]
+        return left - effort(step)
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_a_custom_reward_object_scores_the_same_in_both(env_id: str) -> None:
+    assert run_pair(env_id, 2, 50, reward=_Upright(), max_episode_steps=20) >= 2
 
 
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])
