@@ -2,11 +2,12 @@
 
 Written once for one env and for many: every argument is a float (one body of one env, the
 single env's loop) or an array over sub-envs (and bodies) of the batched env, and the result
-has the same form (:mod:`sgc_env.paper.elementwise`). ``D = world point - nail``,
-``D' = v + omega x r`` with ``r`` the point's lever arm, ``phi`` the rotation from the goal
-orientation to the body's, unwrapped next to its previous value, and the times left to the
-current goals. A body without a position track measures ``D = 0`` and time left 0; one
-without an orientation track keeps its ``phi`` (its first course's start) and time left 0.
+has the same form (:mod:`sgc_env.paper.elementwise`; a float 0 stands for zeros everywhere).
+``D = world point - nail``, ``D' = v + omega x r`` with ``r`` the point's lever arm, ``phi``
+the rotation from the goal orientation to the body's, unwrapped next to its previous value,
+and the times left to the current goals. A body without a position track measures ``D = 0``
+and time left 0; one without an orientation track keeps its ``phi`` (its first course's
+start) and time left 0.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ def measure(
             deviation = tuple(where(has_position, d, 0.0) for d in deviation)
             left = where(has_position, left, 0.0)
     else:
-        deviation, left = _ZERO6, where(has_position, 0.0, 0.0)
+        deviation, left = _ZERO6, 0.0
     if any_(has_orientation):
         new = unwrap_rotvec(log(mul_conjugate(orn, goal_quaternion)), phi)
         orientation_left = orientation_time - time
@@ -60,5 +61,5 @@ def measure(
             orientation_left = where(has_orientation, orientation_left, 0.0)
         phi = new
     else:
-        orientation_left = where(has_orientation, 0.0, 0.0)
+        orientation_left = 0.0
     return point, deviation, left, phi, orientation_left

@@ -24,36 +24,40 @@ Value = Any
 """A float (one env) or a numpy array (one entry per sub-env, or per sub-env and body)."""
 
 
+# One value is a Python bool or float (the single env's case, tested first: it is the hot
+# path of every env step); anything else (an array, a numpy scalar) takes numpy's path.
+
+
 def any_(condition: Value) -> bool:
     """Whether the condition holds anywhere (for one value: whether it holds)."""
-    return bool(condition.any()) if isinstance(condition, np.ndarray) else bool(condition)
+    return condition if condition.__class__ is bool else condition.any()
 
 
 def all_(condition: Value) -> bool:
     """Whether the condition holds everywhere (for one value: whether it holds)."""
-    return bool(condition.all()) if isinstance(condition, np.ndarray) else bool(condition)
+    return condition if condition.__class__ is bool else condition.all()
 
 
 def where(condition: Value, a: Value, b: Value) -> Value:
     """``a`` where the condition holds, else ``b`` (Python's ``a if condition else b``)."""
-    if isinstance(condition, np.ndarray):
-        return np.where(condition, a, b)
-    return a if condition else b
+    if condition.__class__ is bool:
+        return a if condition else b
+    return np.where(condition, a, b)
 
 
 def where3(condition: Value, a: tuple, b: tuple) -> tuple:
     """:func:`where` of each component of two 3-vectors."""
-    if isinstance(condition, np.ndarray):
-        return (
-            np.where(condition, a[0], b[0]),
-            np.where(condition, a[1], b[1]),
-            np.where(condition, a[2], b[2]),
-        )
-    return a if condition else b
+    if condition.__class__ is bool:
+        return a if condition else b
+    return (
+        np.where(condition, a[0], b[0]),
+        np.where(condition, a[1], b[1]),
+        np.where(condition, a[2], b[2]),
+    )
 
 
 def sqrt(x: Value) -> Value:
-    return np.sqrt(x) if isinstance(x, np.ndarray) else math.sqrt(x)
+    return math.sqrt(x) if x.__class__ is float else np.sqrt(x)
 
 
 def atan2(y: Value, x: Value) -> Value:
@@ -66,18 +70,18 @@ def atan2(y: Value, x: Value) -> Value:
 
 def rint(x: Value) -> Value:
     """Round half to even (Python's ``round``, an int for one value; ``np.rint`` on arrays)."""
-    return np.rint(x) if isinstance(x, np.ndarray) else round(x)
+    return round(x) if x.__class__ is float else np.rint(x)
 
 
 def at_most(value: Value, cap: float) -> Value:
     """Python's ``min(value, cap)``: ``value`` unless ``cap < value`` (NaN stays NaN)."""
-    if isinstance(value, np.ndarray):
-        return np.where(cap < value, cap, value)
-    return cap if cap < value else value
+    if value.__class__ is float:
+        return cap if cap < value else value
+    return np.where(cap < value, cap, value)
 
 
 def at_least(value: Value, floor: float) -> Value:
     """Python's ``max(value, floor)``: ``value`` unless ``floor > value``."""
-    if isinstance(value, np.ndarray):
-        return np.where(floor > value, floor, value)
-    return floor if floor > value else value
+    if value.__class__ is float:
+        return floor if floor > value else value
+    return np.where(floor > value, floor, value)
