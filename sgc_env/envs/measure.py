@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from sgc_env.paper.elementwise import all_, any_, where, where3
+from sgc_env.paper.elementwise import where, where3
 from sgc_env.paper.quaternion import log, mul_conjugate, rotate, unwrap_rotvec
 
 __all__ = ["Measured", "measure"]
@@ -33,14 +33,15 @@ def measure(
     """One body's measurement (module docstring); ``state`` is (position, orientation xyzw,
     velocity, angular velocity), each a tuple of components."""
     pos, orn, lin, ang = state
-    if any_(has_offset):
+    # "x is True or x is not False and x.any()": any_(x) inline (module sgc_env.paper.elementwise)
+    if has_offset is True or has_offset is not False and has_offset.any():
         lever = rotate(orn, offset)
         point = (pos[0] + lever[0], pos[1] + lever[1], pos[2] + lever[2])
-        if not all_(has_offset):
+        if has_offset is not True and not has_offset.all():
             lever, point = where3(has_offset, lever, offset), where3(has_offset, point, pos)
     else:
         lever, point = offset, pos
-    if any_(has_position):
+    if has_position is True or has_position is not False and has_position.any():
         wx, wy, wz = ang
         rx, ry, rz = lever
         deviation = (
@@ -48,15 +49,15 @@ def measure(
             lin[0] + wy * rz - wz * ry, lin[1] + wz * rx - wx * rz, lin[2] + wx * ry - wy * rx,
         )  # fmt: skip
         left = position_time - time
-        if not all_(has_position):
+        if has_position is not True and not has_position.all():
             deviation = tuple(where(has_position, d, 0.0) for d in deviation)
             left = where(has_position, left, 0.0)
     else:
         deviation, left = _ZERO6, 0.0
-    if any_(has_orientation):
+    if has_orientation is True or has_orientation is not False and has_orientation.any():
         new = unwrap_rotvec(log(mul_conjugate(orn, goal_quaternion)), phi)
         orientation_left = orientation_time - time
-        if not all_(has_orientation):
+        if has_orientation is not True and not has_orientation.all():
             new = where3(has_orientation, new, phi)
             orientation_left = where(has_orientation, orientation_left, 0.0)
         phi = new

@@ -66,7 +66,12 @@ class PlannerView(ObservationView):
         return gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
 
     def observe(self, record: np.ndarray) -> np.ndarray:
-        return record[:, : self.layout.size].astype(np.float32)
+        return record[:, : self._size].astype(np.float32)
+
+    def bind(self, layout: ObservationLayout) -> ObservationView:
+        view = super().bind(layout)
+        view._size = layout.size  # type: ignore[attr-defined]  # a property that sums: cached
+        return view
 
 
 def make_view(view: object) -> ObservationView:

@@ -25,7 +25,9 @@ Value = Any
 
 
 # One value is a Python bool or float (the single env's case, tested first: it is the hot
-# path of every env step); anything else (an array, a numpy scalar) takes numpy's path.
+# path of every env step); anything else (an array, a numpy scalar) takes numpy's path. The
+# hottest rules spell any_ and all_ out inline, ``c is True or c is not False and c.all()``:
+# for one value a call costs more than the branch itself.
 
 
 def any_(condition: Value) -> bool:
