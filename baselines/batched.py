@@ -21,10 +21,10 @@ from stable_baselines3.common.env_util import is_wrapped, make_vec_env
 from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
 
 from sgc_env import check_env_id
-from sgc_env.envs.vector.batch import Batch
-from sgc_env.envs.vector.infos import row_infos
 from sgc_env.envs.goal_env import SGCGoalEnv
 from sgc_env.envs.sgc_env import SGCEnv
+from sgc_env.envs.vector.batch import Batch
+from sgc_env.envs.vector.infos import row_infos
 
 __all__ = ["VEC_KINDS", "BatchedVecEnv", "has_batched", "make_sgc_vec"]
 

@@ -12,8 +12,8 @@ import pytest
 import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
-from sgc_env.envs.vector import batch as batch_module
 from sgc_env.envs.rewards import REWARD_MODES, RewardMode, StepScore, effort
+from sgc_env.envs.vector import batch as batch_module
 from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
@@ -76,9 +76,9 @@ def run_pair(
     seed: int = 11,
     **kwargs: Any,
 ) -> int:
-    """Step ``gym.make_vec(env_id, n)`` (every id's vector entry point) beside n ``gym.make(env_id)`` envs (reset with seed + i,
-    reset again on their own after an episode, as next-step autoreset does) and assert every
-    output equal. Returns the number of autoresets."""
+    """Step ``gym.make_vec(env_id, n)`` (every id's vector entry point) beside n
+    ``gym.make(env_id)`` envs (reset with seed + i, reset again on their own after an episode,
+    as next-step autoreset does) and assert every output equal. Returns the number of autoresets."""
     vec = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", **kwargs)
     singles = [gym.make(env_id, **kwargs) for _ in range(n)]
     rng = np.random.default_rng(seed)
@@ -112,7 +112,8 @@ def run_pair(
                         twin.bit_generator.state = state
                         vflat = _row(vobs, i)
                         vflat = vflat["observation"] if isinstance(vflat, dict) else vflat
-                        twin_obs = apply_random_push(vec.unwrapped.envs[i], vflat, pushes, twin, tick)
+                        sub_env = vec.unwrapped.envs[i]
+                        twin_obs = apply_random_push(sub_env, vflat, pushes, twin, tick)
                         assert _same(twin_obs, pushed)
                         obs[i] = pushed
                     actions[i] = experts[i](env, obs[i], bool(fresh[i]))

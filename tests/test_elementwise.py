@@ -115,7 +115,8 @@ def test_measure_wrench_and_flags_on_arrays_equal_the_float_ones() -> None:
     nail, goal_q, phi = rng.normal(size=(n, 3)), _quaternions(rng, n), rng.normal(size=(n, 3))
     has_pos, has_ori = rng.uniform(size=n) < 0.8, rng.uniform(size=n) < 0.6
     ptime, otime = rng.uniform(0, 3, n), rng.uniform(0, 3, n)
-    action, limit, scale = rng.uniform(-1, 1, (n, 6)), rng.uniform(1, 9, n), rng.uniform(size=(n, 3))
+    action, limit = rng.uniform(-1, 1, (n, 6)), rng.uniform(1, 9, n)
+    scale = rng.uniform(size=(n, 3))
     low, high = np.full((n, 3), -5.0), np.full((n, 3), 5.0)
     with np.errstate(all="ignore"):
         got = measure(
