@@ -14,6 +14,7 @@ from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
 from sgc_env.envs.rewards import REWARD_MODES, RewardMode, StepScore, effort
 from sgc_env.envs.vector import batch as batch_module
+from sgc_env.envs.vector import task as task_module
 from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
@@ -235,3 +236,13 @@ def test_small_batches_step_each_sub_env(env_id: str, monkeypatch: pytest.Monkey
     finally:
         vec.close()
     assert run_pair(env_id, 2, 45, max_episode_steps=20) >= 2
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_goal_switches_measured_on_arrays_equal_single_envs(
+    env_id: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Sub-envs whose goals switch are measured again one by one on floats, or, when many
+    switch at once, by one pass on arrays: forced here, the same bits."""
+    monkeypatch.setattr(task_module, "SCALAR_MEASURE_ROWS", 0)
+    assert run_pair(env_id, 2, 90, "expert", max_episode_steps=40) >= 2
