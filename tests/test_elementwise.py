@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sgc_env.envs.actuation import body_wrench
+from sgc_env.envs.actuation import body_drive
 from sgc_env.envs.failure import body_flags
 from sgc_env.envs.measure import measure
 from sgc_env.envs.rewards import distance_cost, schedule_cost, square_sum
@@ -86,6 +86,15 @@ def test_track_costs_on_arrays_equal_the_float_ones(cost) -> None:
         assert got.tolist() == want
 
 
+def test_numpy_scalars_take_the_float_path() -> None:
+    """Course entries can be numpy scalars (a track's end velocity); a cost of one env stays a
+    Python float, as rewards are."""
+    course = [np.float64(x) for x in (0.3, -0.2, 0.1, 1.0, 0, 0, 0, 0, 0.5, 0.1, -0.3, 1, 1)]
+    for left in (0.4, -0.7):
+        assert type(schedule_cost((0.1, 0.2, 0.3), left, course, 0.1)) is float
+        assert type(distance_cost((0.1, 0.2, 0.3), left, course, 0.1)) is float
+
+
 def test_square_sum_sums_as_pythons_sum() -> None:
     actions = np.random.default_rng(3).uniform(-1, 1, (64, 18)).astype(np.float32).astype(float)
     assert square_sum(actions).tolist() == [square_sum(row) for row in actions.tolist()]
@@ -123,7 +132,12 @@ def test_measure_wrench_and_flags_on_arrays_equal_the_float_ones() -> None:
             _parts(s), 0.5, _cols(offset), has_offset, _cols(nail), has_pos, ptime,
             _cols(goal_q), has_ori, otime, _cols(phi),
         )  # fmt: skip
-        wrench = body_wrench(_cols(action), _cols(s[:, 3:7]), limit, _cols(scale))
+        mass = rng.uniform(0.5, 2.0, n)
+        coef = [(k / 240, k * (k + 1) / 2 / 240**2) for k in range(4)]
+        wrench = body_drive(
+            _cols(action), _parts(s)[0], _cols(s[:, 3:7]), _parts(s)[2], limit, _cols(scale), mass,
+            (0.0, 0.0, -9.81), coef,
+        )  # fmt: skip
         flags = body_flags(_parts(s), _cols(low), _cols(high))
     rows = [
         measure(
@@ -139,10 +153,16 @@ def test_measure_wrench_and_flags_on_arrays_equal_the_float_ones() -> None:
     ]
     _same((*got[0], *got[1], got[2], *got[3], got[4]), rows)
     wrenches = [
-        body_wrench(action[i].tolist(), s[i, 3:7].tolist(), float(limit[i]), scale[i].tolist())
+        body_drive(
+            action[i].tolist(), s[i, 0:3].tolist(), s[i, 3:7].tolist(), s[i, 7:10].tolist(),
+            float(limit[i]), scale[i].tolist(), float(mass[i]), (0.0, 0.0, -9.81), coef,
+        )
         for i in range(n)
-    ]
-    _same((*wrench[0], *wrench[1]), [(*f, *t) for f, t in wrenches])
+    ]  # fmt: skip
+    _same(
+        (*wrench[0], *wrench[1], *(x for p in wrench[2] for x in p)),
+        [(*f, *t, *(x for p in path for x in p)) for f, t, path in wrenches],
+    )
     single = [
         body_flags(_parts(np.array(s[i].tolist())), low[i].tolist(), high[i].tolist())
         for i in range(n)

@@ -21,7 +21,7 @@ from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.scenario import Scenario
 from sgc_env.simulator import BodyReading, Drive, Simulator
 
-__all__ = ["Actuation", "body_wrench", "clip_action", "com_path"]
+__all__ = ["Actuation", "body_drive", "clip_action"]
 
 
 def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
@@ -44,33 +44,31 @@ def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
     return values
 
 
-def body_wrench(
-    action: Sequence[Any], orientation: Sequence[Any], force_limit: Any, torque_scale: Sequence[Any]
-) -> tuple[tuple, tuple | None]:
-    """One body's force and torque (world frame) from its action entries: force xyz (then
-    torque xyz, or no torque for 3 entries), and its orientation at the step's start. The rule
-    of both envs: floats for one env, arrays over sub-envs for the batched env."""
-    fx, fy, fz = action[0] * force_limit, action[1] * force_limit, action[2] * force_limit
-    if len(action) == 3:
-        return (fx, fy, fz), None
-    sx, sy, sz = torque_scale
-    bx, by, bz = rotate_back(orientation, (action[3], action[4], action[5]))
-    return (fx, fy, fz), rotate(orientation, (bx * sx, by * sy, bz * sz))
-
-
-def com_path(
-    position: Sequence[Any], velocity: Sequence[Any], force: Sequence[Any], mass: Any,
+def body_drive(
+    action: Sequence[Any], position: Sequence[Any], orientation: Sequence[Any],
+    velocity: Sequence[Any], force_limit: Any, torque_scale: Sequence[Any], mass: Any,
     gravity: Sequence[float], coef: Sequence[tuple[float, float]],
-) -> list[tuple]:  # fmt: skip
-    """The centre of mass before each substep under semi-implicit Euler:
-    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``)."""
+) -> tuple[tuple, tuple | None, list[tuple]]:  # fmt: skip
+    """One body's control period, the actuation rule of both envs (floats for one env, arrays
+    over sub-envs for the batched env): the force and torque (world frame) from its action
+    entries, force xyz then torque xyz (no torque for 3 entries), and its state at the step's
+    start; and the centre of mass before each substep under semi-implicit Euler,
+    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``), where
+    the force acts."""
+    fx, fy, fz = action[0] * force_limit, action[1] * force_limit, action[2] * force_limit
+    torque = None
+    if len(action) == 6:
+        sx, sy, sz = torque_scale
+        bx, by, bz = rotate_back(orientation, (action[3], action[4], action[5]))
+        torque = rotate(orientation, (bx * sx, by * sy, bz * sz))
     gx, gy, gz = gravity
-    ax, ay, az = force[0] / mass + gx, force[1] / mass + gy, force[2] / mass + gz
+    ax, ay, az = fx / mass + gx, fy / mass + gy, fz / mass + gz
     x0, y0, z0 = position
     vx, vy, vz = velocity
-    return [
+    path = [
         (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az) for kh, c in coef
     ]
+    return (fx, fy, fz), torque, path
 
 
 class Actuation:
@@ -120,11 +118,13 @@ class Actuation:
         applied_t: list[float] = []
         for i, (pos, orn, lin, _) in enumerate(states):
             o = i * per
-            f, tq = body_wrench(values[o : o + per], orn, self._flimit[i], self._tscale[i])
+            f, tq, path = body_drive(
+                values[o : o + per], pos, orn, lin, self._flimit[i], self._tscale[i],
+                self._mass[i], gravity, coef,
+            )  # fmt: skip
             applied_f += f
             if tq is not None:
                 applied_t += tq
-            path = com_path(pos, lin, f, self._mass[i], gravity, coef)
             drives.append((self._uids[i], f, tq, path))
         return drives, applied_f + (applied_t or self._zeros3n)
 

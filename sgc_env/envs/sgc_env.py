@@ -168,6 +168,7 @@ class SGCEnv(gym.Env):
         }  # fmt: skip
         self.reward_mode = reward
         self._reward = make_reward(reward)
+        self._score = StepScore([], 1, 0.0, 1, 0.0, False, 0)  # filled every step
         self._view = make_view(observation)
         if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
             raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
@@ -211,6 +212,7 @@ class SGCEnv(gym.Env):
             "render_modes": available_render_modes(),
         }
         self._n = len(base.bodies)
+        self._score.n_bodies = self._n
         self.use_torque = not all(
             b.shape == "sphere" and not b.has_orientation_track for b in base.bodies
         )
@@ -394,7 +396,7 @@ class SGCEnv(gym.Env):
         self._record.pack_into(buffer, 0, *flat)
         arr = np.frombuffer(buffer)
         size = self._block_end
-        self._obs = self._view.observe(arr.reshape(1, -1))[0]
+        self._obs = self._view.observe(arr)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
         self._failed = not ok
@@ -437,10 +439,10 @@ class SGCEnv(gym.Env):
             if changed:
                 self._observe(read=False)
         terminated = self._failed
-        score = StepScore(
-            tracks_of(task), self._n, square_sum(values), len(values), goal_bonus(events),
-            terminated, self.max_steps - self._tick,
-        )  # fmt: skip
+        score = self._score  # one per env, refilled: the mode reads it during this call only
+        score.tracks, score.square_sum = tracks_of(task), square_sum(values)
+        score.action_size, score.bonus = len(values), goal_bonus(events)
+        score.failed, score.steps_left = terminated, self.max_steps - self._tick
         reward = self._reward.reward(score)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)

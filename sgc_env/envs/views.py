@@ -2,10 +2,11 @@
 
 A view turns the step record (:mod:`.record`: per body the planner's block of doubles, the
 time, points, forces and torques), an (N, record) float64 array, into the (N, size) float32
-observations of N sub-envs at once; the single env is N = 1 and the batched env hands the
-array out as it is. Both envs run the same :meth:`ObservationView.observe`. ``SGCEnv(...,
-observation=...)`` picks a view by name (:data:`VIEWS`) or takes an instance; a new view is one
-subclass registered with :func:`observation_view`.
+observations of N sub-envs at once, and one env's record (record,) into its observation; the
+batched env hands the array out as it is. Both envs run the same
+:meth:`ObservationView.observe`. ``SGCEnv(..., observation=...)`` picks a view by name
+(:data:`VIEWS`) or takes an instance; a new view is one subclass registered with
+:func:`observation_view`.
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ class ObservationView:
         raise NotImplementedError
 
     def observe(self, record: np.ndarray) -> np.ndarray:
-        """The observations (N, size) float32 of N sub-envs' step records (N, record)."""
+        """The observations (N, size) float32 of N sub-envs' step records (N, record); for one
+        env, a record (record,) gives its observation (size,) (index with ``...``)."""
         raise NotImplementedError
 
 
@@ -66,7 +68,7 @@ class PlannerView(ObservationView):
         return gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
 
     def observe(self, record: np.ndarray) -> np.ndarray:
-        return record[:, : self._size].astype(np.float32)
+        return record[..., : self._size].astype(np.float32)
 
     def bind(self, layout: ObservationLayout) -> ObservationView:
         view = super().bind(layout)

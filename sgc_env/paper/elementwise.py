@@ -24,8 +24,9 @@ Value = Any
 """A float (one env) or a numpy array (one entry per sub-env, or per sub-env and body)."""
 
 
-# One value is a Python bool or float (the single env's case, tested first: it is the hot
-# path of every env step); anything else (an array, a numpy scalar) takes numpy's path. The
+# Many values are a numpy array (the class is tested, not isinstance: the single env's hot
+# path); anything else is one value, a Python or numpy scalar, and takes Python's path (math's
+# functions give Python floats for numpy scalars too, as the float code always did). The
 # hottest rules spell any_ and all_ out inline, ``c is True or c is not False and c.all()``:
 # for one value a call costs more than the branch itself.
 
@@ -42,14 +43,14 @@ def all_(condition: Value) -> bool:
 
 def where(condition: Value, a: Value, b: Value) -> Value:
     """``a`` where the condition holds, else ``b`` (Python's ``a if condition else b``)."""
-    if condition.__class__ is bool:
-        return a if condition else b
-    return np.where(condition, a, b)
+    if condition.__class__ is np.ndarray:
+        return np.where(condition, a, b)
+    return a if condition else b
 
 
 def where3(condition: Value, a: tuple, b: tuple) -> tuple:
     """:func:`where` of each component of two 3-vectors."""
-    if condition.__class__ is bool:
+    if condition.__class__ is not np.ndarray:
         return a if condition else b
     return (
         np.where(condition, a[0], b[0]),
@@ -59,12 +60,12 @@ def where3(condition: Value, a: tuple, b: tuple) -> tuple:
 
 
 def sqrt(x: Value) -> Value:
-    return math.sqrt(x) if x.__class__ is float else np.sqrt(x)
+    return np.sqrt(x) if x.__class__ is np.ndarray else math.sqrt(x)
 
 
 def atan2(y: Value, x: Value) -> Value:
     """``math.atan2``, per element on arrays (libm's result, as for one value)."""
-    if not isinstance(y, np.ndarray):
+    if y.__class__ is not np.ndarray:
         return math.atan2(y, x)
     out = list(map(math.atan2, y.ravel().tolist(), np.broadcast_to(x, y.shape).ravel().tolist()))
     return np.array(out, dtype=np.float64).reshape(y.shape)
@@ -72,18 +73,18 @@ def atan2(y: Value, x: Value) -> Value:
 
 def rint(x: Value) -> Value:
     """Round half to even (Python's ``round``, an int for one value; ``np.rint`` on arrays)."""
-    return round(x) if x.__class__ is float else np.rint(x)
+    return np.rint(x) if x.__class__ is np.ndarray else round(x)
 
 
 def at_most(value: Value, cap: float) -> Value:
     """Python's ``min(value, cap)``: ``value`` unless ``cap < value`` (NaN stays NaN)."""
-    if value.__class__ is float:
-        return cap if cap < value else value
-    return np.where(cap < value, cap, value)
+    if value.__class__ is np.ndarray:
+        return np.where(cap < value, cap, value)
+    return cap if cap < value else value
 
 
 def at_least(value: Value, floor: float) -> Value:
     """Python's ``max(value, floor)``: ``value`` unless ``floor > value``."""
-    if value.__class__ is float:
-        return floor if floor > value else value
-    return np.where(floor > value, floor, value)
+    if value.__class__ is np.ndarray:
+        return np.where(floor > value, floor, value)
+    return floor if floor > value else value

@@ -28,7 +28,7 @@ import numpy as np
 from sgc_env.observation import BODY_BLOCK_SIZE
 from sgc_env.simulator import BodyReading, pybullet
 
-from ..actuation import body_wrench, com_path
+from ..actuation import body_drive
 from ..failure import body_flags
 from ..measure import measure
 from ..record import body_block, pack_blocks
@@ -223,7 +223,10 @@ class BatchTask:
         n, b = self.n, self.b
         a = _cols(actions.reshape(n, b, 6 if self.use_torque else 3))
         pos, orn, lin, _ = _parts(self.state)
-        force, torque = body_wrench(a, orn, self.flimit, _cols(self.tscale))
+        force, torque, path = body_drive(
+            a, pos, orn, lin, self.flimit, _cols(self.tscale), self.mass, _cols(self.gravity),
+            self.coef,
+        )  # fmt: skip
         forces = np.stack(force, axis=-1)
         self.applied[:, : 3 * b] = forces.reshape(n, -1)
         torques = None
@@ -232,7 +235,6 @@ class BatchTask:
             self.applied[:, 3 * b :] = torques.reshape(n, -1)
         else:
             self.applied[:, 3 * b :] = 0.0
-        path = com_path(pos, lin, force, self.mass, _cols(self.gravity), self.coef)
         return forces, torques, np.stack([np.stack(p, axis=-1) for p in path])
 
     def _physics(
