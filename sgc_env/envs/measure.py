@@ -12,30 +12,33 @@ start) and time left 0.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from sgc_env.paper.elementwise import where, where3
 from sgc_env.paper.quaternion import log, mul_conjugate, rotate, unwrap_rotvec
 
+Vec = Sequence[Any]  # components: floats for one env, arrays for the batch
+
 __all__ = ["Measured", "measure"]
 
 _ZERO6 = (0.0,) * 6
 
-Measured = tuple[tuple, tuple, Any, tuple, Any]
+Measured = tuple[Any, Any, Any, Any, Any]
 """(tracked point 3, deviation D and D' 6, position time left, phi 3, orientation time left)."""
 
 
 def measure(
-    state: tuple, time: Any, offset: tuple, has_offset: Any, nail: tuple, has_position: Any,
-    position_time: Any, goal_quaternion: tuple, has_orientation: Any, orientation_time: Any,
-    phi: tuple,
+    state: Vec, time: Any, offset: Vec, has_offset: Any, nail: Vec, has_position: Any,
+    position_time: Any, goal_quaternion: Vec, has_orientation: Any, orientation_time: Any,
+    phi: Vec,
 ) -> Measured:  # fmt: skip
     """One body's measurement (module docstring); ``state`` is (position, orientation xyzw,
     velocity, angular velocity), each a tuple of components."""
     pos, orn, lin, ang = state
     # "x is True or x is not False and x.any()": any_(x) inline (module sgc_env.paper.elementwise)
     if has_offset is True or has_offset is not False and has_offset.any():
-        lever = rotate(orn, offset)
+        lever: Any = rotate(orn, offset)
         point = (pos[0] + lever[0], pos[1] + lever[1], pos[2] + lever[2])
         if has_offset is not True and not has_offset.all():
             lever, point = where3(has_offset, lever, offset), where3(has_offset, point, pos)

@@ -12,11 +12,14 @@ than numpy on tiny arrays), one cast of a whole array for the batch.
 from __future__ import annotations
 
 import operator
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, float32_residuals
+
+Vec = Sequence[Any]  # components: floats for one env, arrays for the batch
 
 __all__ = ["body_block", "pack_blocks", "residuals"]
 
@@ -30,8 +33,8 @@ def residuals(values: list[Any]) -> list[Any]:
 
 
 def body_block(
-    state: tuple, offset: tuple, deviation: tuple, position_left: Any, position_course: tuple,
-    phi: tuple, orientation_left: Any, orientation_course: tuple, offset_residual: tuple,
+    state: Vec, offset: Vec, deviation: Vec, position_left: Any, position_course: Vec,
+    phi: Vec, orientation_left: Any, orientation_course: Vec, offset_residual: Vec,
 ) -> list[Any]:  # fmt: skip
     """One body's block in :data:`~sgc_env.observation.BODY_FIELDS` order (the residual
     slots in ``RESIDUAL_FIELDS`` order, pinned by a test; the point offset's is cached with

@@ -414,11 +414,11 @@ class SGCEnv(gym.Env):
 
     def _drives(
         self, values: list[float]
-    ) -> tuple[list[Drive], list[list[tuple[int, tuple[float, ...]]]]]:
+    ) -> tuple[list[Drive], list[list[tuple[int, list[float]]]]]:
         """The bodies' drives and the props' moves (one list per substep) of the next control
         period; the batched env gathers these from every sub-env into one physics step."""
         drives, self._applied = self._actuation.drives(values, self._states)
-        moves: list[list[tuple[int, tuple[float, ...]]]] = []
+        moves: list[list[tuple[int, list[float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
             at = self._props.at

@@ -70,6 +70,8 @@ class PlannerView(ObservationView):
     def observe(self, record: np.ndarray) -> np.ndarray:
         return record[..., : self._size].astype(np.float32)
 
+    _size = 0
+
     def bind(self, layout: ObservationLayout) -> ObservationView:
         view = super().bind(layout)
         view._size = layout.size  # type: ignore[attr-defined]  # a property that sums: cached

@@ -14,6 +14,7 @@ bit. ``sqrt`` is correctly rounded in both.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -48,7 +49,7 @@ def where(condition: Value, a: Value, b: Value) -> Value:
     return a if condition else b
 
 
-def where3(condition: Value, a: tuple, b: tuple) -> tuple:
+def where3(condition: Value, a: Sequence[Any], b: Sequence[Any]) -> Any:
     """:func:`where` of each component of two 3-vectors."""
     if condition.__class__ is not np.ndarray:
         return a if condition else b
