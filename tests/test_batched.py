@@ -16,6 +16,7 @@ from sgc_env.envs.rewards import REWARD_MODES, RewardMode, StepScore, effort
 from sgc_env.envs.vector import batch as batch_module
 from sgc_env.envs.vector import task as task_module
 from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
+from sgc_env.envs.views import ObservationView
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
 SIZES = {"SGCThreeRodsRandom-v2": (2, 40), "SGCThreeRods-v1": (2, 45)}
@@ -163,6 +164,26 @@ class _Upright(RewardMode):
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
 def test_a_custom_reward_object_scores_the_same_in_both(env_id: str) -> None:
     assert run_pair(env_id, 2, 50, reward=_Upright(), max_episode_steps=20) >= 2
+
+
+class _ClockView(ObservationView):
+    """A view of the caller's own: each body's position and the time, from the record."""
+
+    def space(self) -> gym.spaces.Box:
+        return gym.spaces.Box(-1e5, 1e5, (3 * self.layout.n_bodies + 1,), np.float32)
+
+    def observe(self, record: np.ndarray) -> np.ndarray:
+        layout = self.layout
+        parts = [record[..., layout.body_slice(j, "position")] for j in range(layout.n_bodies)]
+        parts.append(record[..., layout.global_slice("time")])
+        return np.concatenate(parts, axis=-1).astype(np.float32)
+
+
+@pytest.mark.parametrize("env_id", ["SGCThreeRods-v1", "SGCPointGoal-v0"])
+def test_a_custom_observation_view_observes_the_same_in_both(env_id: str) -> None:
+    assert run_pair(env_id, 2, 50, observation=_ClockView(), max_episode_steps=20) >= 2
+    with pytest.raises(ValueError, match="observation: unknown view 'learner'.*planner"):
+        gym.make(env_id, observation="learner")
 
 
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])

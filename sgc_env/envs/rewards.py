@@ -56,6 +56,8 @@ import numpy as np
 
 from sgc_env.paper.elementwise import any_, at_least, at_most, sqrt, where
 
+from .choices import choose
+
 if TYPE_CHECKING:
     from .task import GoalEvent, GoalTask
 
@@ -282,11 +284,4 @@ REWARD_MODES: tuple[str, ...] = tuple(REWARD_CLASSES)
 def make_reward(mode: object) -> RewardMode:
     """The mode ``mode`` names (one of :data:`REWARD_MODES`), or ``mode`` itself when it is a
     :class:`RewardMode`."""
-    if isinstance(mode, RewardMode):
-        return mode
-    if not isinstance(mode, str) or mode not in REWARD_CLASSES:
-        raise ValueError(
-            f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)} or a "
-            "sgc_env.envs.rewards.RewardMode instance"
-        )
-    return REWARD_CLASSES[mode]()
+    return choose("reward", "mode", mode, REWARD_CLASSES, RewardMode)

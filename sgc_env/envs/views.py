@@ -16,6 +16,8 @@ import numpy as np
 
 from sgc_env.observation import ObservationLayout
 
+from .choices import choose
+
 __all__ = ["OBS_BOUND", "VIEWS", "ObservationView", "PlannerView", "make_view", "observation_view"]
 
 OBS_BOUND = 1e5
@@ -80,11 +82,4 @@ class PlannerView(ObservationView):
 
 def make_view(view: object) -> ObservationView:
     """The view ``view`` names (one of :data:`VIEWS`), or ``view`` itself when it is one."""
-    if isinstance(view, ObservationView):
-        return view
-    if not isinstance(view, str) or view not in VIEWS:
-        raise ValueError(
-            f"observation: unknown view {view!r}; expected one of {list(VIEWS)} or a "
-            "sgc_env.envs.views.ObservationView instance"
-        )
-    return VIEWS[view]()
+    return choose("observation", "view", view, VIEWS, ObservationView)
