@@ -36,7 +36,7 @@ myst_heading_anchors = 4
 """GitHub-style anchors, so ``page.md#section`` links work on the site as on GitHub."""
 
 autosummary_generate = True
-autodoc_default_options = {"members": True, "show-inheritance": True}
+autodoc_default_options = {"show-inheritance": True}
 autodoc_typehints = "description"
 autodoc_member_order = "bysource"
 napoleon_google_docstring = True
