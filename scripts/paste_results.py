@@ -149,17 +149,21 @@ def summary_block(results_doc: str) -> str:
             f"{leaderboard_summary(board)}")  # fmt: skip
 
 
-def body_of(name: str, root: Path = ROOT) -> str:
-    """The block ``name`` as it should read now, from its command's last output."""
-    if name == SUMMARY:
-        return summary_block((root / SUMMARY_SOURCE).read_text())
-    output = root / RESULTS[name].output
+def body_from(name: str, output: Path) -> str:
+    """The block ``name`` from its command's output file ``output``."""
     if not output.is_file():
         raise ValueError(f"{output}: missing; run `{RESULTS[name].command}` (or pass --run)")
     text = output.read_text()
     if output.suffix == ".json":
         text = demo_table(json.loads(text))
     return table_block(name, text)
+
+
+def body_of(name: str, root: Path = ROOT) -> str:
+    """The block ``name`` as it should read now, from its command's last output."""
+    if name == SUMMARY:
+        return summary_block((root / SUMMARY_SOURCE).read_text())
+    return body_from(name, root / RESULTS[name].output)
 
 
 def documents(root: Path = ROOT) -> list[Path]:
