@@ -41,8 +41,8 @@ def test_every_recipe_resolves_on_its_envs(name: str) -> None:
 
 
 def test_the_timed_recipes_resolve_with_a_fixed_step_budget() -> None:
-    """benchmarks/archive/fast_recipes*.yml are the 10-seed timed sweeps: a fixed number of steps (so
-    a seed gives one model), hyperparameters that resolve on their id."""
+    """benchmarks/archive/fast_recipes*.yml are the 10-seed timed sweeps: a fixed number of
+    steps (so a seed gives one model), hyperparameters that resolve on their id."""
     from baselines.agents.hyperparams import load_hyperparams
     from baselines.benchmark.grid import load_recipes
 
