@@ -201,7 +201,7 @@ class DynamicConstraintsController(_StatefulPolicy):
 
     Per track (position, orientation) of each body the controller pursues its *own* current
     goal: per component D'' + (2/tau) D' + D/tau^2 = 0, each tick landing on the closed-form
-    D(dt) from the measured (D, D') via deadbeat actuation. When |D| < ``eps`` (m) or
+    D(dt) from the measured (D, D') via deadbeat actuation. When ``|D| < eps`` (m) or
     ``eps_orientation`` (rad) the goal counts as met and the next goal starts at once.
 
     Goal switching versus the env's clock (the env advances goals at their times):
@@ -215,9 +215,9 @@ class DynamicConstraintsController(_StatefulPolicy):
       goal after it (counted as missed by the metrics).
     - after the last goal it keeps converging on it.
 
-    tau per course (:func:`choose_tau`): from rest at the nominal course start |D_i(0)|
-    (previous nail minus nail, from the scenario), |D| falls to eps exactly at the nominal
-    course duration T_i. Courses with |D_i(0)| <= 2 eps use 2 eps. The force and torque
+    tau per course (:func:`choose_tau`): from rest at the nominal course start ``|D_i(0)|``
+    (previous nail minus nail, from the scenario), ``|D|`` falls to eps exactly at the nominal
+    course duration T_i. Courses with ``|D_i(0)| <= 2 eps`` use 2 eps. The force and torque
     limits of the env clip the law where it asks for more (it starts hard: D0/tau^2).
     Different body points per goal are not modelled: the look-ahead uses the current goal's.
     ``events`` lists the meetings of the episode in progress (last sub-env used).

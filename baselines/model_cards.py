@@ -77,7 +77,7 @@ def card_markdown(entry: Mapping[str, Any], fresh: Mapping[str, Any], gif: str |
     lines = [
         f"# Model card: `{stem}`",
         "",
-        f"- **Env**: [`{env_id}`](../../docs/environments.md#{env_id.lower()})",
+        f"- **Env**: [`{env_id}`](../../docs/envs/{env_id}.md)",
         f"- **Algorithm**: {str(entry['algo']).upper()} (Stable-Baselines3)",
         f"- **Recipe**: {recipe(entry)}",
         f"- **Training seed**: {entry['seed']}",

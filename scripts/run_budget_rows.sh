@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 21's equal wall-clock rows (docs/agents.md, "Equal wall-clock budgets"): every budget
+# The equal wall-clock leaderboard (docs/results.md; budgets explained in docs/agents.md): every budget
 # recipe of benchmarks/recipes.yml x 10 training seeds, one run per core (--workers 2 on the
 # 2-core machine; torch uses one thread per run). Resumable: rerun the same command and the
 # finished runs are skipped; with --report-only it runs nothing and writes the leaderboard

@@ -64,3 +64,33 @@ def test_help_shows_defaults(capsys) -> None:
     assert "(default: 0.02)" in evaluate
     train = _help("train", capsys)
     assert "training seed (default: 0)" in train and "(default: cpu)" in train
+
+
+_DEMO_TABLE = """
+import sys
+from types import SimpleNamespace
+from baselines.cli.commands.demo import scorecard_table
+from baselines.cli.console import make_console
+rod = dict(rod="rod_gold", goals=25, goals_met=25, position_error_max_m=2.0e-15,
+           orientation_error_max_rad=3.7e-15, closest_approach_offset_max_s=1.8e-15,
+           sparc_track=-2.21, goal_speed_ratio_min=0.68, acceleration_kink=15.1,
+           angular_acceleration_kink=29.2)
+result = SimpleNamespace(label="expert", per_rod=[rod] * 3)
+make_console().print(scorecard_table(SimpleNamespace(policy="expert", end_rule="tangent"), result))
+"""
+
+
+def test_tables_in_a_log_keep_every_number_whole() -> None:
+    """Piped to a file (a CI log), the demo's scorecard is not squeezed to 80 columns."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k not in ("COLUMNS", "LINES")}
+    out = subprocess.run([sys.executable, "-c", _DEMO_TABLE], stdout=subprocess.PIPE,
+                         text=True, check=True, env=env).stdout  # fmt: skip
+    assert "…" not in out
+    row = next(line for line in out.splitlines() if "rod_gold" in line)
+    for cell in ("2.0e-15", "3.7e-15", "1.8e-15", "-2.21", "29.2"):
+        assert cell in row, (cell, row)
+    assert max(len(line) for line in out.splitlines()) > 80  # wider than the old pipe default

@@ -7,7 +7,7 @@ from pathlib import Path
 import gymnasium as gym
 
 import sgc_env
-from sgc_env.env_cards import CARDS, card_markdown, cards_markdown, gif_path
+from sgc_env.env_cards import CARDS, card_markdown, gif_path, pages
 
 ROOT = Path(__file__).resolve().parents[1]
 SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards", "Starting State",
@@ -38,5 +38,20 @@ def test_cards_read_spaces_from_the_envs():
     assert "`Dict`" in goal and "compute_reward" in goal
 
 
-def test_environments_doc_holds_the_generated_cards():
-    assert cards_markdown() in (ROOT / "docs" / "environments.md").read_text()
+def test_the_env_pages_are_what_the_cards_generate():
+    """docs/envs holds one page per id, exactly as ``python -m sgc_env.env_cards --write``
+    writes it (rerun it after changing a card or an env's spaces)."""
+    folder = ROOT / "docs" / "envs"
+    expected = pages()
+    assert sorted(p.name for p in folder.glob("*.md")) == sorted(expected)
+    for name, text in expected.items():
+        assert (folder / name).read_text() == text, f"docs/envs/{name} is stale"
+
+
+def test_the_model_zoo_page_includes_every_shipped_card():
+    """docs/zoo.md includes each card in baselines/checkpoints (a new model needs its line)."""
+    zoo = (ROOT / "docs" / "zoo.md").read_text()
+    cards = sorted((ROOT / "baselines" / "checkpoints").glob("*.md"))
+    assert cards
+    for card in cards:
+        assert f"```{{include}} ../baselines/checkpoints/{card.name}\n" in zoo, card.name

@@ -1,10 +1,12 @@
 """Presentation shared by the commands: help with defaults, the one-line result summary, and
-a console sized to the person's terminal."""
+a console sized to the person's terminal (or, in a log, wide enough for every number)."""
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
 from collections.abc import Mapping
 from typing import Any
 
@@ -12,6 +14,11 @@ __all__ = ["DefaultsHelpFormatter", "make_console", "summary_line"]
 
 WIDE_WIDTH = 240
 """Console width of ``--wide`` output (lines longer than the terminal wrap, cells stay whole)."""
+
+LOG_WIDTH = 1000
+"""Console width when stdout is a file or a pipe and ``COLUMNS`` is unset: wider than any of
+our tables, so a CI log or a redirected run keeps every cell whole instead of Rich's default
+80 columns, which squeezes numbers to "2.0…". Tables are as wide as their content, not this."""
 
 
 class DefaultsHelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -28,10 +35,15 @@ class DefaultsHelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
 
 def make_console(wide: bool = False) -> Any:
-    """A Rich console: the terminal's width (or ``COLUMNS``; 80 in a pipe), ``WIDE_WIDTH`` wide."""
+    """A Rich console: ``WIDE_WIDTH`` with ``wide``; else the terminal's width, or ``COLUMNS``
+    where it is set, or ``LOG_WIDTH`` when stdout is not a terminal (a log keeps every digit)."""
     from rich.console import Console
 
-    return Console(width=WIDE_WIDTH) if wide else Console()
+    if wide:
+        return Console(width=WIDE_WIDTH)
+    if sys.stdout.isatty() or os.environ.get("COLUMNS"):
+        return Console()
+    return Console(width=LOG_WIDTH)
 
 
 def _number(value: Any, spec: str, unit: str) -> str:

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import env_kwargs
+from baselines.cli.console import make_console
 
 __all__ = ["add_arguments", "run"]
 
@@ -188,14 +189,13 @@ def _record(outcome: dict[str, Any], folder: Path, counts: dict[str, int], conso
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
 
     from baselines.benchmark.aggregate import aggregate_runs
     from baselines.benchmark.backends import make_backend
     from baselines.benchmark.execute import FAILED_FILE, RESULT_FILE
     from baselines.benchmark.report import write_report
 
-    console = Console()
+    console = make_console()
     try:
         grid = _grid(args)
         backend = make_backend(args.backend, args.workers, args.address, args.cpus_per_run)

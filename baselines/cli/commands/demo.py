@@ -32,6 +32,7 @@ from baselines.cli.checks import (
     staged_output,
     trust_model,
 )
+from baselines.cli.console import make_console
 
 __all__ = ["add_arguments", "run"]
 
@@ -118,14 +119,13 @@ def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int
     import dataclasses
 
     import gymnasium as gym
-    from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from baselines.cli.demo import ENV_ID, cpu_seconds, run_demo
     from baselines.cli.demo_compare import write_side_by_side
     from baselines.evaluation import write_summary_json
 
-    console = Console()
+    console = make_console()
     started = time.perf_counter()
     compare = len(options) > 1
     results = []

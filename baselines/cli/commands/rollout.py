@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import add_trust_argument, nonneg_int, out_dir, trust_model
+from baselines.cli.console import make_console
 
 __all__ = ["add_arguments", "make_env", "run"]
 
@@ -71,13 +72,12 @@ def _save_npz(path: Path, traj: dict[str, Any], goals: list[list[Any]]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
 
     from baselines.cli import plots
     from baselines.evaluation import run_episode, write_summary_json
     from baselines.policies import make_policy, policy_label
 
-    console = Console()
+    console = make_console()
     try:
         env, name = make_env(args.scenario, args.env, args.video)
     except ValueError as exc:
