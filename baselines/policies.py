@@ -4,14 +4,14 @@ Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tan
 ``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``expert-matched`` (SGC with
 end velocities solved over whole tracks so accelerations match, :mod:`sgc_env.paper.matched`),
 ``expert-smooth`` (SGC sub-courses between transient sub-goals on the minimum-jerk reference,
-:mod:`baselines.smooth_table`), ``dynamic-constraints``,
+:mod:`baselines.controllers.smooth_table`), ``dynamic-constraints``,
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
-:mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
+:mod:`baselines.common.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
-then). Model files are loaded without unpickling anything (:mod:`baselines.model_files`)
+then). Model files are loaded without unpickling anything (:mod:`baselines.models.model_files`)
 unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model trained
 behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
-(:func:`vecnormalize_path`, :mod:`baselines.normalization`), so it sees the observations it
+(:func:`vecnormalize_path`, :mod:`baselines.models.normalization`), so it sees the observations it
 was trained on. Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
@@ -27,7 +27,7 @@ from typing import Any, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
-from baselines.comparison_policies import (
+from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
     MinimumJerkController,
     episode_model,
@@ -35,10 +35,10 @@ from baselines.comparison_policies import (
     predict_per_env,
     scenario_of,
 )
-from baselines.expert import SGCExpert
-from baselines.model_files import algorithm_from_data, load_sb3_model
-from baselines.normalization import load_statistics, statistics_path
-from baselines.shipped import resolve_policy_spec
+from baselines.controllers.expert import SGCExpert
+from baselines.models.model_files import algorithm_from_data, load_sb3_model
+from baselines.models.normalization import load_statistics, statistics_path
+from baselines.common.shipped import resolve_policy_spec
 
 __all__ = [
     "BUILTIN_POLICIES",
@@ -190,7 +190,7 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 
 
 def vecnormalize_path(model_path: str | Path) -> Path | None:
-    """The ``VecNormalize`` statistics saved with a model (see :mod:`baselines.normalization`)."""
+    """The ``VecNormalize`` statistics saved with a model (see :mod:`baselines.models.normalization`)."""
     return statistics_path(model_path)
 
 
@@ -249,7 +249,7 @@ def make_policy(
     """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``.
 
     ``trust_model``: unpickle model files (None: as :func:`trusted_models` says, by default
-    not; see :mod:`baselines.model_files`).
+    not; see :mod:`baselines.models.model_files`).
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")

@@ -130,7 +130,7 @@ def test_train_rejects_bad_arguments(tiny_hp: Path) -> None:
 def test_smoke_train_save_load_evaluate(
     algo: str, env_id: str, tiny_hp: Path, tmp_path: Path
 ) -> None:
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
 
     out = tmp_path / algo
     result = train(
@@ -384,7 +384,7 @@ CHECKPOINTS = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
 
 
 def test_shipped_checkpoints_are_small_and_score() -> None:
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
 
     models = sorted(CHECKPOINTS.glob("*.zip"))
     if not models:
@@ -411,7 +411,7 @@ SHIPPED_SCORES = {
 
 
 def _schedule_model_summary(episodes: int) -> dict:
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
 
     model = CHECKPOINTS / "ppo_schedule_SGCPoint-v0.zip"
     return dict(evaluate(str(model), "SGCPoint-v0", episodes, 20_000).summary)
@@ -435,7 +435,7 @@ def test_model_learned_without_demonstrations_on_fifty_held_out_episodes() -> No
 
 
 def _rod_model_summary(episodes: int) -> dict:
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
 
     model = CHECKPOINTS / "ppo_dagger_SGCRod-v0.zip"
     return dict(evaluate(str(model), "SGCRod-v0", episodes, 10_000).summary)

@@ -11,8 +11,8 @@ from stable_baselines3.common.evaluation import evaluate_policy
 from stable_baselines3.common.vec_env import VecNormalize
 
 from baselines import SGCExpert
-from baselines.batched import BatchedVecEnv, make_sgc_vec
-from baselines.vector import base_env
+from baselines.agents.sb3_vec_env import BatchedVecEnv, make_sgc_vec
+from baselines.common.sub_envs import base_env
 from sgc_env.envs import batch as batch_module
 
 
@@ -110,8 +110,8 @@ def test_adapter_refuses_bad_input() -> None:
 
 @pytest.mark.parametrize("policy", ["dc", "mj"])
 def test_comparison_policies_run_on_the_batched_env(policy: str) -> None:
-    """They read each sub-env's scenario through ``envs`` (baselines.vector.sub_env)."""
-    from baselines.comparison_policies import DynamicConstraintsController, MinimumJerkController
+    """They read each sub-env's scenario through ``envs`` (baselines.common.sub_envs.sub_env)."""
+    from baselines.controllers.comparison_policies import DynamicConstraintsController, MinimumJerkController
 
     cls = DynamicConstraintsController if policy == "dc" else MinimumJerkController
     runs = []

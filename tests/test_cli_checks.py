@@ -114,7 +114,7 @@ def test_interrupted_evaluate_keeps_the_earlier_results(tmp_path, monkeypatch, c
 
 
 def test_interrupted_demo_leaves_no_stub_video_beside_old_plates(tmp_path, monkeypatch):
-    import baselines.cli.demo as demo_module
+    import baselines.figures.demo as demo_module
 
     out = tmp_path / "demo"
     out.mkdir()
@@ -157,7 +157,7 @@ def test_interrupted_train_keeps_the_earlier_run_and_the_new_checkpoints(tmp_pat
 
 
 def test_interrupted_demos_save_keeps_the_earlier_file(tmp_path, monkeypatch):
-    import baselines.atomic_files as atomic
+    import baselines.common.atomic_files as atomic
 
     out = tmp_path / "d.npz"
     out.write_bytes(b"the earlier, whole demos")

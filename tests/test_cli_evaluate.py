@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from baselines.cli import main as cli
-from baselines.evaluation import GOAL_COLUMNS
+from baselines.evaluation.harness import GOAL_COLUMNS
 
 SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
 

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from baselines.dynamic_constraints import (
+from baselines.controllers.dynamic_constraints import (
     DynamicConstraintsCourse,
     choose_tau,
     desired_acceleration,

@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from baselines.episodes import run_episodes_batched, sub_info
-from baselines.evaluation import evaluate, json_ready
+from baselines.evaluation.episodes import run_episodes_batched, sub_info
+from baselines.evaluation.harness import evaluate, json_ready
 from baselines.policies import make_policy
 from sgc_env.envs.vector_env import make_vec
 

@@ -66,8 +66,8 @@ def test_import_sgc_env_loads_no_baselines_no_planner_no_scipy():
 
 def test_the_detector_sees_a_lazy_upward_import(tmp_path):
     module = tmp_path / "lazy.py"
-    module.write_text("def f():\n    from baselines.expert import SGCExpert\n    return 1\n")
-    assert "baselines.expert" in _imported_modules(module)
+    module.write_text("def f():\n    from baselines.controllers.expert import SGCExpert\n    return 1\n")
+    assert "baselines.controllers.expert" in _imported_modules(module)
 
 
 @pytest.mark.parametrize(
@@ -89,24 +89,24 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("sgc_env.envs",),
     ("sgc_env",),  # the package: registers the ids
     ("sgc_env.ladder", "sgc_env.env_cards"),
-    ("baselines.vector", "baselines.observation_fields", "baselines.minimum_jerk",
-     "baselines.tracking", "baselines.dynamic_constraints", "baselines.shipped"),
-    ("baselines.atomic_files", "baselines.value_types", "baselines.env_kwargs",
-     "baselines.agents.features", "baselines.agents.schedule_features"),
-    ("baselines.env_model",),
-    ("baselines.agents.per_body",),
-    ("baselines.normalization", "baselines.model_files"),
-    ("baselines.actuation",),
-    ("baselines.matched_table", "baselines.smooth_table"),
-    ("baselines.expert",),
-    ("baselines.comparison_policies",),
+    ("baselines.common.sub_envs", "baselines.common.observation_fields", "baselines.controllers.minimum_jerk",
+     "baselines.controllers.tracking", "baselines.controllers.dynamic_constraints", "baselines.common.shipped"),
+    ("baselines.common.atomic_files", "baselines.common.value_types", "baselines.common.env_kwargs",
+     "baselines.models.features", "baselines.models.schedule_features"),
+    ("baselines.common.env_model",),
+    ("baselines.models.per_body",),
+    ("baselines.models.normalization", "baselines.models.model_files"),
+    ("baselines.controllers.actuation",),
+    ("baselines.controllers.matched_table", "baselines.controllers.smooth_table"),
+    ("baselines.controllers.expert",),
+    ("baselines.controllers.comparison_policies",),
     ("baselines.policies", "baselines"),
-    ("baselines.episodes",),
-    ("baselines.evaluation",),
-    ("baselines.episode_gif",),
+    ("baselines.evaluation.episodes",),
+    ("baselines.evaluation.harness",),
+    ("baselines.figures.episode_gif",),
     ("baselines.agents",),
     ("baselines.benchmark",),
-    ("baselines.model_cards",),
+    ("baselines.zoo.cards",),
     ("baselines.cli",),
 )  # fmt: skip
 """The parts of ``sgc_env`` and ``baselines``, bottom up: a part imports only parts of lower

@@ -10,7 +10,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from baselines.benchmark.manifest import (  # noqa: E402
+from baselines.zoo.manifest import (  # noqa: E402
     CHECKPOINTS,
     ENTRY_FIELDS,
     check_manifest,
@@ -79,7 +79,7 @@ def test_manifest_errors_name_the_problem(tmp_path: Path) -> None:
 def test_shipped_model_carries_its_normalisation(tmp_path: Path) -> None:
     """A VecNormalize model shipped by ship_model scores the same alone as in its run."""
     from baselines.agents.train import TrainConfig, train
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
 
     hp = tmp_path / "hp"
     hp.mkdir()

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from baselines.dynamic_constraints import choose_tau, simulate
-from baselines.minimum_jerk import MinimumJerkPath
+from baselines.controllers.dynamic_constraints import choose_tau, simulate
+from baselines.controllers.minimum_jerk import MinimumJerkPath
 from sgc_env.metrics import (
     BodyTrajectory,
     GoalSpec,

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import BSpline, PPoly
 from scipy.spatial.transform import Rotation
 
-from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.controllers.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 
 TIMES = np.array([0.0, 0.7, 1.5, 2.0, 3.1])
 POINTS = np.random.default_rng(1).normal(size=(5, 3))

@@ -244,7 +244,7 @@ def test_shipped_model_on_the_wrong_env_names_the_env_it_was_trained_on(
 
 
 def test_safe_and_trusted_loading_predict_alike(clean: Path) -> None:
-    from baselines.model_files import load_sb3_model
+    from baselines.models.model_files import load_sb3_model
 
     env = gym.make("SGCPoint-v0")
     obs, _ = env.reset(seed=3)

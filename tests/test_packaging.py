@@ -14,7 +14,7 @@ import pytest
 import sgc_env
 from baselines.agents.hyperparams import load_hyperparams
 from baselines.policies import make_policy
-from baselines.shipped import (
+from baselines.common.shipped import (
     hyperparams_file,
     resolve_policy_spec,
     shipped_files,

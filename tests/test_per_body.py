@@ -18,15 +18,15 @@ from stable_baselines3 import PPO  # noqa: E402
 
 import sgc_env  # noqa: E402
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
-from baselines.agents.per_body import (  # noqa: E402
+from baselines.models.per_body import (  # noqa: E402
     BODY_ACTIONS,
     BODY_FEATURES,
     REFERENCE_ACCELERATION,
     PerBodyPolicy,
     body_gains,
 )
-from baselines.evaluation import evaluate  # noqa: E402
-from baselines.model_files import load_sb3_model  # noqa: E402
+from baselines.evaluation.harness import evaluate  # noqa: E402
+from baselines.models.model_files import load_sb3_model  # noqa: E402
 from sgc_env.observation import BODY_BLOCK_SIZE  # noqa: E402
 
 RECIPE = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams" / "ppo_threerod"
@@ -150,7 +150,7 @@ def test_the_recipe_names_the_policy_and_the_current_random_id() -> None:
     assert hp.algo_kwargs["policy_kwargs"]["gains_env"] == RANDOM_ID
     assert hp.algo_kwargs["policy_kwargs"]["skip"] is True
     with pytest.raises(ValueError, match="features_extractor_class must be ScheduleFeatures"):
-        from baselines.agents.features import StandardizeObservation
+        from baselines.models.features import StandardizeObservation
 
         _model(RANDOM_ID, features_extractor_class=StandardizeObservation)
 
@@ -159,7 +159,7 @@ def test_the_shipped_model_flies_the_paper_scene() -> None:
     """Issue 22's bar on the paper's scene (>= 90 % of its 58 goals), for the model trained
     without demonstrations on the random family (docs/agents.md); one episode: the scene is
     fixed and the policy deterministic."""
-    from baselines.benchmark.manifest import CHECKPOINTS, load_manifest
+    from baselines.zoo.manifest import CHECKPOINTS, load_manifest
 
     name = "ppo_perbody_SGCThreeRodsRandom-v2.zip"
     entry = next(e for e in load_manifest(CHECKPOINTS) if e["file"] == name)

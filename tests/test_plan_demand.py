@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from baselines.expert import SGCExpert
+from baselines.controllers.expert import SGCExpert
 from sgc_env.envs import SGCEnv
 from sgc_env.paper.end_rules import END_RULES
 from sgc_env.scenario import ScenarioError, resolve_scenario, scenario_from_dict

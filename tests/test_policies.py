@@ -37,11 +37,11 @@ def _rollout(env, policy, seed):
 
 
 def test_exports_are_the_classes():
-    from baselines.comparison_policies import DynamicConstraintsController as dc
-    from baselines.expert import SGCExpert as expert
+    from baselines.controllers.comparison_policies import DynamicConstraintsController as dc
+    from baselines.controllers.expert import SGCExpert as expert
 
     assert DynamicConstraintsController is dc and SGCExpert is expert
-    assert MinimumJerkController.__module__ == "baselines.comparison_policies"
+    assert MinimumJerkController.__module__ == "baselines.controllers.comparison_policies"
 
 
 @pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0"])
@@ -173,7 +173,7 @@ def test_models_trained_behind_vecnormalize_get_their_statistics(tmp_path, model
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
-    from baselines.normalization import save_statistics
+    from baselines.models.normalization import save_statistics
 
     env = gym.make("SGCPoint-v0")
     ppo = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import sgc_env
-from baselines.expert import SGCExpert
+from baselines.controllers.expert import SGCExpert
 from sgc_env.envs import SGCEnv
 from sgc_env.paper.routing import resolve_goal_times
 from sgc_env.scenario import resolve_scenario, scenario_from_dict

@@ -67,7 +67,7 @@ def test_rejected_swap_leaves_the_env_exactly_as_it_was():
 
 def test_rejected_swap_keeps_the_harness_scoring_the_old_goals():
     from baselines import SGCExpert
-    from baselines.evaluation import run_episode
+    from baselines.evaluation.harness import run_episode
 
     env = SGCEnv("rod_basic")
     with pytest.raises(ValueError):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import sgc_env  # noqa: F401  (registers the ids)
-from baselines.expert import SGCExpert
+from baselines.controllers.expert import SGCExpert
 from sgc_env.envs import SGCEnv
 
 WATCHED = ("SGCRod-v0", "SGCThreeRods-v1", "SGCIntercept-v0")

@@ -8,11 +8,11 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import sgc_env
-from baselines.actuation import wrench_for_targets
-from baselines.comparison_policies import DynamicConstraintsController, MinimumJerkController
-from baselines.env_model import EnvModel
-from baselines.expert import SGCExpert
-from baselines.observation_fields import read_body
+from baselines.controllers.actuation import wrench_for_targets
+from baselines.controllers.comparison_policies import DynamicConstraintsController, MinimumJerkController
+from baselines.common.env_model import EnvModel
+from baselines.controllers.expert import SGCExpert
+from baselines.common.observation_fields import read_body
 from baselines.policies import make_policy
 from sgc_env.envs.rewards import REWARD_MODES
 

@@ -11,7 +11,7 @@ import pytest
 
 pytest.importorskip("rl_zoo3", reason="rl_zoo3 is in the dev extra")
 
-from baselines.shipped import hyperparams_file  # noqa: E402
+from baselines.common.shipped import hyperparams_file  # noqa: E402
 
 
 def test_rl_zoo3_trains_ppo_on_sgc_point(tmp_path: Path) -> None:

@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from baselines import SGCExpert  # noqa: E402
-from baselines.evaluation import run_episode  # noqa: E402
+from baselines.evaluation.harness import run_episode  # noqa: E402
 from sgc_env.envs import SGCEnv  # noqa: E402
 from sgc_env.scenario import ScenarioError, resolve_scenario, scenario_from_dict  # noqa: E402
 from sgc_env.scenario.load import builtin_path, scenario_from_yaml  # noqa: E402

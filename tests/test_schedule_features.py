@@ -16,7 +16,7 @@ import torch as th  # noqa: E402
 
 import sgc_env  # noqa: E402, F401
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
-from baselines.agents.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
+from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
 from baselines.agents.train import TrainConfig, train  # noqa: E402
 from sgc_env.envs.rewards import TRACK_COST_CAP, schedule_cost, tracks_of  # noqa: E402
 
@@ -133,7 +133,7 @@ def test_normalize_field_errors_name_it(tmp_path: Path, value: str, match: str) 
 
 
 def test_model_on_the_features_evaluates_from_its_file_alone(tmp_path: Path) -> None:
-    from baselines.evaluation import evaluate
+    from baselines.evaluation.harness import evaluate
     from baselines.policies import load_sb3_model
 
     (tmp_path / "ppo.yml").write_text(

@@ -1,5 +1,5 @@
 """The smooth rule (expert-smooth): SGC sub-courses between transient sub-goals on the
-minimum-jerk reference (baselines/smooth_table.py, issue 23)."""
+minimum-jerk reference (baselines/controllers/smooth_table.py, issue 23)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import sgc_env  # noqa: F401  (registers the ids)
-from baselines.evaluation import evaluate
-from baselines.expert import SGCExpert
-from baselines.matched_table import course_key, course_row
-from baselines.smooth_table import LONGEST_SUBCOURSE, smooth_table
+from baselines.evaluation.harness import evaluate
+from baselines.controllers.expert import SGCExpert
+from baselines.controllers.matched_table import course_key, course_row
+from baselines.controllers.smooth_table import LONGEST_SUBCOURSE, smooth_table
 from sgc_env.paper import quaternion as quat
 
 GOAL_TOLERANCE = 1e-9

@@ -7,7 +7,7 @@ import pybullet as p
 import pytest
 from scipy.spatial.transform import Rotation
 
-from baselines.tracking import (
+from baselines.controllers.tracking import (
     _linear_model,
     _linear_model_axisymmetric,
     _simulate_axisymmetric,

@@ -1,6 +1,6 @@
 """The expert through every kind of vector env, in-process and behind processes.
 
-One accessor (:mod:`baselines.vector`) serves all four; the expert must meet its goals the
+One accessor (:mod:`baselines.common.sub_envs`) serves all four; the expert must meet its goals the
 same way on each (position errors at the goal ticks ~1e-15 m, far inside any tolerance).
 """
 
@@ -17,7 +17,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 import sgc_env  # noqa: F401  (registers the ids)
 from baselines import SGCExpert
 from baselines.policies import make_policy
-from baselines.vector import base_env
+from baselines.common.sub_envs import base_env
 
 
 def _two(kind: type) -> Callable[[str], Any]:

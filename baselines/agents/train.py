@@ -20,7 +20,7 @@ import numpy as np
 
 from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
 from baselines.agents.pushes import Pushes
-from baselines.env_kwargs import check_env_kwargs
+from baselines.common.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
@@ -84,7 +84,7 @@ class TrainResult:
 
 
 def _make_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], vec: str | None):
-    from baselines.batched import make_sgc_vec
+    from baselines.agents.sb3_vec_env import make_sgc_vec
 
     return make_sgc_vec(env_id, n_envs, seed, env_kwargs, vec)
 
@@ -155,7 +155,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         StatisticsCheckpointCallback,
     )
     from baselines.agents.hyperparams import load_hyperparams
-    from baselines.normalization import save_statistics
+    from baselines.models.normalization import save_statistics
 
     _validate(cfg)
     started = time.perf_counter()
@@ -172,7 +172,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
     kwargs = dict(hp.algo_kwargs)
     if cfg.init == "bc":
-        from baselines.agents.features import StandardizeObservation
+        from baselines.models.features import StandardizeObservation
 
         policy_kwargs = dict(kwargs.get("policy_kwargs") or {})
         policy_kwargs.setdefault("features_extractor_class", StandardizeObservation)
@@ -285,7 +285,7 @@ def _clone(model: Any, cfg: TrainConfig, deadline: float | None = None) -> dict[
     no DAgger round starts after ``deadline`` (a ``time.perf_counter()`` reading)."""
     from baselines.agents.bc import behaviour_clone, dagger, imitation_loss
     from baselines.agents.demos import load_demos
-    from baselines.agents.features import set_statistics
+    from baselines.models.features import set_statistics
 
     demos = load_demos(cfg.demos)  # type: ignore[arg-type]
     if demos.env_id != cfg.env_id:
@@ -317,7 +317,7 @@ def load_model(
     path: str | Path, env: Any | None = None, device: str = "cpu", trust_model: bool = False
 ) -> Any:
     """Load an SB3 ``.zip`` whatever algorithm wrote it, without unpickling unless
-    ``trust_model`` (:mod:`baselines.model_files`; safe loading needs ``env``)."""
-    from baselines.model_files import load_sb3_model
+    ``trust_model`` (:mod:`baselines.models.model_files`; safe loading needs ``env``)."""
+    from baselines.models.model_files import load_sb3_model
 
     return load_sb3_model(path, env=env, device=device, trust_model=trust_model)

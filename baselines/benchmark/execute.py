@@ -17,7 +17,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from baselines.atomic_files import write_atomic
+from baselines.common.atomic_files import write_atomic
 from baselines.benchmark.grid import RunSpec, train_command
 
 __all__ = ["FAILED_FILE", "RESULT_FILE", "execute_run", "write_outcome"]
@@ -56,7 +56,7 @@ def _curve_schedule(spec: RunSpec) -> dict[str, Any]:
 
 
 def _score(model: Path, spec: RunSpec) -> dict[str, Any]:
-    from baselines.evaluation import evaluate, json_ready
+    from baselines.evaluation.harness import evaluate, json_ready
 
     result = evaluate(
         str(model), spec.env_id, spec.eval_episodes, spec.test_seed,

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from baselines.atomic_files import write_atomic
+from baselines.common.atomic_files import write_atomic
 from baselines.benchmark.aggregate import (
     CONFIDENCE,
     CURVE_AXES,

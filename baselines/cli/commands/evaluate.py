@@ -243,13 +243,13 @@ def _goals_met_line(summaries: Sequence[Mapping[str, Any]]) -> str:
 
 
 def _write_pair(result: Any, out: Path, plots: bool) -> None:
-    from baselines.evaluation import write_goals_csv, write_summary_json
+    from baselines.evaluation.harness import write_goals_csv, write_summary_json
 
     write_goals_csv(result.rows, out / "goals.csv")
     write_summary_json(result.summary, out / "summary.json")
     if not plots:
         return
-    from baselines.cli.plots import plot_goal_errors, plot_speed_profile, trajectory_arrays
+    from baselines.figures.plots import plot_goal_errors, plot_speed_profile, trajectory_arrays
 
     title = f"{result.policy} on {result.env_id}"
     plot_goal_errors(result.rows, out / "goal_errors.png", title=title)
@@ -261,7 +261,7 @@ def _write_pair(result: Any, out: Path, plots: bool) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from baselines.cli.console import make_console, summary_line
-    from baselines.evaluation import evaluate, json_ready
+    from baselines.evaluation.harness import evaluate, json_ready
     from baselines.policies import policy_labels, trusted_models
     from sgc_env.metrics import Tolerances
 

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
     from baselines.cli import plots
-    from baselines.evaluation import run_episode, write_summary_json
+    from baselines.evaluation.harness import run_episode, write_summary_json
     from baselines.policies import make_policy, policy_label
 
     console = Console()

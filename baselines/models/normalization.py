@@ -27,7 +27,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.atomic_files import write_atomic
+from baselines.common.atomic_files import write_atomic
 
 __all__ = [
     "FORMAT",

@@ -7,7 +7,7 @@ observation in ``info["terminal_observation"]`` and ``info["TimeLimit.truncated"
 SB3's TimeLimit handling expects. ``seed(s)`` seeds sub-env i with ``s + i`` at the next
 reset, as DummyVecEnv does. Episode statistics come from ``VecMonitor`` (:func:`make_sgc_vec`
 adds it), since there is no per-env ``Monitor``. ``envs`` lists the sub-envs, so
-:func:`baselines.vector.sub_env` and the expert read them as they read DummyVecEnv's.
+:func:`baselines.common.sub_envs.sub_env` and the expert read them as they read DummyVecEnv's.
 """
 
 from __future__ import annotations

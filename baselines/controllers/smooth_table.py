@@ -4,7 +4,7 @@ An SGC course solves its behaviour equation from position and velocity only, so 
 acceleration jumps at every goal, and on a long course through a change of pace its own jerk
 is several times a spline's (docs/smoothness.md). The smooth rule therefore gives the expert
 *transient sub-goals*: per body and track it builds the C4 minimum-jerk reference through the
-track's real goals at their times (:mod:`baselines.minimum_jerk`, the law of the
+track's real goals at their times (:mod:`baselines.controllers.minimum_jerk`, the law of the
 ``minimum-jerk`` baseline), samples it at control ticks, and every sub-course between two
 sub-goals is an ordinary SGC course that starts and ends on the reference with the
 reference's velocity. The env, its goals and its schedule are untouched: sub-goals live in
@@ -20,12 +20,12 @@ change of pace, where an SGC course through a few ticks bends away from the spli
 one tick (then the course is the reference's next sample). One tick's change of acceleration
 along the expert's plan is then about the reference's plus at most twice the tolerance.
 
-The expert (:class:`baselines.expert.SGCExpert`, ``end_rule="smooth"``) re-solves the current
+The expert (:class:`baselines.controllers.expert.SGCExpert`, ``end_rule="smooth"``) re-solves the current
 sub-course every tick from the measured deviation from its sub-goal and the sub-course's
 planned rate (:meth:`SubGoals.planned_rate`), and lands every tick's rotation by the exact
 Newton step; docs/smoothness.md has the measurements behind both choices.
 
-The table is keyed like the matched rule's (:mod:`baselines.matched_table`): body, track and
+The table is keyed like the matched rule's (:mod:`baselines.controllers.matched_table`): body, track and
 the course's float32 observation entries, so a stateless expert finds its course from any
 state of the episode; courses of another scenario are not found.
 """
@@ -38,8 +38,8 @@ from typing import cast
 
 import numpy as np
 
-from baselines.matched_table import course_key, course_row
-from baselines.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
+from baselines.controllers.matched_table import course_key, course_row
+from baselines.controllers.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 from sgc_env.envs.tracks import Track, compile_tracks
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import Profile, Rows, Vec3, _component_profiles, _frame_rows, _mul, _mul_t

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from baselines.vector import base_env
+from baselines.common.sub_envs import base_env
 from sgc_env.observation import ObservationLayout
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.end_rules import DEFAULT_END_RULE

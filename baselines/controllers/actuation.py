@@ -2,7 +2,7 @@
 
 A model-based policy decides where a body's tracked point and orientation should be at the
 next control tick; :func:`wrench_for_targets` turns that into the world force and torque that
-put it there through PyBullet's integrator (:mod:`baselines.tracking`). The expert, the
+put it there through PyBullet's integrator (:mod:`baselines.controllers.tracking`). The expert, the
 dynamic-constraints and the minimum-jerk baselines differ only in how they choose targets.
 """
 
@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.env_model import BodyModel, EnvModel
-from baselines.observation_fields import BodyObservation
-from baselines.tracking import (
+from baselines.common.env_model import BodyModel, EnvModel
+from baselines.common.observation_fields import BodyObservation
+from baselines.controllers.tracking import (
     held_acceleration_for_position,
     simulate_rotation,
     torque_for_orientation,
@@ -69,7 +69,7 @@ def body_wrench(
 
     The expert calls this every control step, where numpy and scipy calls on 3-vectors would
     cost more than the arithmetic. ``refine=False`` skips the correction step of the torque
-    between goals (see :func:`baselines.tracking.torque_for_orientation`).
+    between goals (see :func:`baselines.controllers.tracking.torque_for_orientation`).
     """
     h, n = model.sim_dt, model.substeps
     q = orientation

@@ -13,7 +13,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from baselines.cli.demo import DemoResult, write_mp4
+from baselines.figures.demo import DemoResult, write_mp4
 
 __all__ = ["COMPARE_VIDEO", "side_by_side", "write_side_by_side"]
 

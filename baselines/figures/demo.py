@@ -5,7 +5,7 @@ end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``) 
 policy spec :func:`baselines.policies.make_policy` accepts (``DemoOptions.policy``), scored by
 the shared harness, and rendered headless through the renderer of ``env.render()``
 (:mod:`sgc_env.render`: TinyRenderer for the bodies, then sky, checkered floor, shadows,
-fading trails, nails) from the cameras of :mod:`baselines.cli.demo_camera`. Rods are drawn
+fading trails, nails) from the cameras of :mod:`baselines.figures.demo_camera`. Rods are drawn
 thicker than their physical radius, and each red ball that its rod's tip really met (came
 within the ball's radius of its centre, :func:`pierce_times`) rides on that rod from the tick
 of closest approach on; a ball never met flies on along its own path (visual only: the render
@@ -28,8 +28,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from baselines.cli.demo_camera import camera_at
-from baselines.episode_gif import gif_durations, write_gif
+from baselines.figures.demo_camera import camera_at
+from baselines.figures.episode_gif import gif_durations, write_gif
 from sgc_env.paper.end_rules import END_RULES
 from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
@@ -185,7 +185,7 @@ class DemoScene:
 def demo_policy(options: DemoOptions, env: Any) -> Any:
     """The policy that flies the demo; a ValueError (exit 2 in the CLI) if the spec is unknown
     or a model file does not fit the three-rod env (checked before anything is unpickled)."""
-    from baselines.expert import SGCExpert
+    from baselines.controllers.expert import SGCExpert
     from baselines.policies import make_policy
 
     if options.policy == "expert":  # as before --policy existed: the same outputs, bit for bit
@@ -211,7 +211,7 @@ def run_demo(
     episode and then of the drawing (``total`` counts both)."""
     import gymnasium as gym
 
-    from baselines.evaluation import (
+    from baselines.evaluation.harness import (
         goal_rows,
         run_episode,
         summarize,
@@ -335,7 +335,7 @@ def _per_rod(
 
 
 def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
-    from baselines.cli.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
+    from baselines.figures.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
 
     traj = trajectory_arrays(record.infos, record.initial_info)
     names = [b.name for b in scenario.bodies]

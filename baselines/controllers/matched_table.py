@@ -6,7 +6,7 @@ expert therefore reads the scenario once per episode (as the env compiles it) an
 course up by its observation entries: course start, duration, next start and next duration,
 as float32, exactly as the observation carries them. A state of that episode, visited or
 not (DAgger queries), finds its course; a course of another scenario does not, and the expert
-then falls back to the tangent rule (:class:`baselines.expert.SGCExpert`).
+then falls back to the tangent rule (:class:`baselines.controllers.expert.SGCExpert`).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ __all__ = ["EXPERT_RULES", "course_key", "course_row", "matched_table"]
 
 EXPERT_RULES: tuple[str, ...] = ("tangent", "paper", "matched", "smooth")
 """End rules the expert plays: the scenario's two (:data:`sgc_env.paper.end_rules.END_RULES`)
-and ``"matched"`` and ``"smooth"`` (:mod:`baselines.smooth_table`), which need the scenario's
+and ``"matched"`` and ``"smooth"`` (:mod:`baselines.controllers.smooth_table`), which need the scenario's
 whole tracks."""
 
 MatchedTable = dict[tuple[float, ...], tuple[tuple[float, float, float], bool]]

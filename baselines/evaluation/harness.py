@@ -3,7 +3,7 @@
 ``evaluate(policy, env_id, episodes, seed)`` runs episode k with ``reset(seed=seed + k)``,
 keeps the reset info and every step's info, scores each episode with
 :func:`sgc_env.metrics.score_episode` against :func:`goals_from_scenario` of the scenario the
-episode actually ran (:mod:`baselines.episodes`), and aggregates. ``num_envs`` > 1 runs the
+episode actually ran (:mod:`baselines.evaluation.episodes`), and aggregates. ``num_envs`` > 1 runs the
 episodes on that many sub-envs of the batched env at once, with the same episodes. It imports
 neither torch nor SB3 (only a model path spec does, through
 :func:`baselines.policies.make_policy`), so a training callback can call it with the model
@@ -24,7 +24,7 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env
-from baselines.episodes import EpisodeRecord, run_episode, run_episodes_batched
+from baselines.evaluation.episodes import EpisodeRecord, run_episode, run_episodes_batched
 from baselines.policies import Policy, make_policy, policy_label
 from sgc_env.envs.vector_env import make_vec
 from sgc_env.metrics import Tolerances

@@ -3,7 +3,7 @@
 The bodies of an SGC scene never interact, and every body's goals enter the observation in
 the same per-body block, so the three-rod problem is three copies of one 6-D problem.
 :class:`PerBodyPolicy` maps each body's slice of the learner features
-(:class:`~baselines.agents.schedule_features.ScheduleFeatures`, 16 per track) through the same
+(:class:`~baselines.models.schedule_features.ScheduleFeatures`, 16 per track) through the same
 MLP to that body's 6-D action and concatenates the actions; the critic averages per-body values
 (the env's reward is a mean over bodies). Three bodies give three samples of the shared net
 per env step, and the same weights run on any number of bodies.
@@ -18,7 +18,7 @@ trained on one scale drives the other at the wrong gain and hover. The gains are
 env (:func:`body_gains`: mass, force and torque limits, inertia, gravity, the facts the expert
 also reads), at construction from the env id named in ``gains_env`` (saved in the ``.zip`` with
 the other policy kwargs) and again, for the env a saved model is loaded on, by
-:meth:`PerBodyPolicy.bind_env` (:func:`baselines.model_files.load_sb3_model` calls it).
+:meth:`PerBodyPolicy.bind_env` (:func:`baselines.models.model_files.load_sb3_model` calls it).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
-from baselines.agents.schedule_features import TRACK_FEATURES, ScheduleFeatures
-from baselines.env_model import EnvModel
+from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
+from baselines.common.env_model import EnvModel
 
 __all__ = [
     "BODY_ACTIONS",

@@ -43,7 +43,7 @@ def episode_gif(env_id: str, policy: str, path: str | Path, *, seed: int = 0, wi
                 env_kwargs: Mapping[str, Any] | None = None) -> Path:  # fmt: skip
     """Run ``policy`` (a spec of :func:`baselines.policies.make_policy`) for one episode from
     ``reset(seed=seed)`` and write its GIF to ``path``."""
-    from baselines.evaluation import run_episode
+    from baselines.evaluation.harness import run_episode
     from baselines.policies import make_policy
 
     if fps <= 0:

@@ -3,7 +3,7 @@
 Every control step the expert re-plans the rest of the current course from the measured state
 (the SGC family is time-consistent, so with nothing disturbing the body this *is* the plan
 made at the course start) and then chooses the force and torque that land the body exactly on
-the plan's next sample, through the known PyBullet integrator (:mod:`baselines.tracking`). On
+the plan's next sample, through the known PyBullet integrator (:mod:`baselines.controllers.tracking`). On
 the tick that reaches a goal the next sample is the goal itself, so goals are met to floating
 point. A push mid-course simply becomes a new measured state to re-plan from.
 
@@ -19,12 +19,12 @@ from typing import Any
 
 import numpy as np
 
-from baselines.actuation import body_wrench
-from baselines.env_model import BodyModel, EnvModel
-from baselines.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
-from baselines.observation_fields import COURSE_SIZE, BodyFields, TrackFields
-from baselines.smooth_table import SmoothCourse, SmoothTable, smooth_table
-from baselines.vector import base_env
+from baselines.controllers.actuation import body_wrench
+from baselines.common.env_model import BodyModel, EnvModel
+from baselines.controllers.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
+from baselines.common.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.controllers.smooth_table import SmoothCourse, SmoothTable, smooth_table
+from baselines.common.sub_envs import base_env
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
@@ -61,11 +61,11 @@ class SGCExpert:
         """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
         :mod:`sgc_env.paper.frames`), ``"matched"`` (:mod:`sgc_env.paper.matched`:
         accelerations matched over whole tracks) or ``"smooth"`` (SGC sub-courses between
-        transient sub-goals on the minimum-jerk reference, :mod:`baselines.smooth_table`);
+        transient sub-goals on the minimum-jerk reference, :mod:`baselines.controllers.smooth_table`);
         None follows the scenario (``model.end_rule``). ``"matched"`` and ``"smooth"`` read the
         episode's scenario (``scenario``, else ``env``'s current one, re-read when a course is
-        not found) and look every course up in their table (:mod:`baselines.matched_table`,
-        :mod:`baselines.smooth_table`); a course they do not know (a state of another
+        not found) and look every course up in their table (:mod:`baselines.controllers.matched_table`,
+        :mod:`baselines.controllers.smooth_table`); a course they do not know (a state of another
         scenario) ends by the tangent rule.
 
         ``refine``: give the torque between goals its correction step on the simulated
@@ -161,7 +161,7 @@ class SGCExpert:
         if o[track.flags] > 0.5 and time_left > 0.5 * period:
             phi = f.vec(o, track.deviation)
             smooth = self._smooth_course(index, "orientation", o, track)
-            if smooth is not None:  # every tick lands exactly (baselines.smooth_table)
+            if smooth is not None:  # every tick lands exactly (baselines.controllers.smooth_table)
                 smooth_rotation = True
                 phi, time_left, rows, end_rate, rate = _toward_subgoal(
                     smooth, phi, time_left, period
@@ -273,7 +273,7 @@ def _toward_subgoal(
 ) -> tuple[tuple, float, tuple, tuple, tuple]:
     """The deviation from the next sub-goal, the time to it, the frame of its sub-course, the
     reference's velocity there and the sub-course's planned rate now
-    (:mod:`baselines.smooth_table`). Deviations are measured from the reference's sub-goal
+    (:mod:`baselines.controllers.smooth_table`). Deviations are measured from the reference's sub-goal
     (for a rotation its principal log: the env's unwrapped deviation can take the other way
     round than the reference), but on the tick that reaches a real goal the env's deviation
     is kept, so the goal is met exactly."""

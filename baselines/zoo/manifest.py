@@ -4,7 +4,7 @@ Each entry says what the model is and how it came about (``file`` relative to th
 ``env_id``, ``algo``, ``demonstrations``, ``timesteps``, ``seed``, ``wall_time_s``,
 ``command``) and what it scores on held-out seeds (``result``). A model trained behind
 ``VecNormalize`` ships with its statistics as ``<stem>.vecnormalize.json`` beside it (plain
-JSON, :mod:`baselines.normalization`; no pickle is shipped), which
+JSON, :mod:`baselines.models.normalization`; no pickle is shipped), which
 :func:`baselines.policies.make_policy` restores. :func:`ship_model` copies a run's model in
 and writes its entry (``scripts/ship_model.py`` is its command line).
 """
@@ -79,7 +79,7 @@ def held_out_result(
     model: str | Path, env_id: str, episodes: int, seed: int, env_kwargs: Mapping | None = None
 ) -> dict[str, Any]:
     """Score ``model`` with the harness and keep the manifest's :data:`RESULT_KEYS`."""
-    from baselines.evaluation import evaluate, json_ready
+    from baselines.evaluation.harness import evaluate, json_ready
 
     summary = evaluate(str(model), env_id, episodes, seed, env_kwargs=env_kwargs, keep_infos=0)
     return json_ready(

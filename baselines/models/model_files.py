@@ -65,9 +65,9 @@ def allowed_classes() -> dict[str, type]:
     from stable_baselines3.sac import policies as sac
     from stable_baselines3.td3 import policies as td3
 
-    from baselines.agents.features import ACTIVATIONS, StandardizeObservation
-    from baselines.agents.per_body import PerBodyPolicy
-    from baselines.agents.schedule_features import ScheduleFeatures
+    from baselines.models.features import ACTIVATIONS, StandardizeObservation
+    from baselines.models.per_body import PerBodyPolicy
+    from baselines.models.schedule_features import ScheduleFeatures
 
     classes: list[type] = [
         policies.ActorCriticPolicy, policies.ActorCriticCnnPolicy,

@@ -3,7 +3,7 @@
 A card gives the env, algorithm, recipe, training seed and steps, wall clock, the held-out
 results measured when the model was shipped (read from the manifest, which says where they
 were measured), a fresh held-out evaluation run by the card step itself (``episodes`` from
-``seed``, :func:`baselines.benchmark.manifest.held_out_result`, the same harness), the command
+``seed``, :func:`baselines.zoo.manifest.held_out_result`, the same harness), the command
 that reproduces it, and a GIF of one episode (``docs/images/model_<stem>.gif``). ``sgc card``
 and ``scripts/ship_model.py`` write them.
 """
@@ -18,8 +18,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from baselines.benchmark.manifest import CHECKPOINTS, held_out_result, load_manifest
-from baselines.normalization import statistics_path
+from baselines.zoo.manifest import CHECKPOINTS, held_out_result, load_manifest
+from baselines.models.normalization import statistics_path
 
 __all__ = ["DOCS_IMAGES", "card_markdown", "machine", "recipe", "write_model_card"]
 
@@ -131,7 +131,7 @@ def write_model_card(entry: Mapping[str, Any], *, episodes: int = 10, seed: int 
     """Evaluate the model of ``entry`` on ``episodes`` held-out seeds from ``seed`` (default:
     the manifest result's first seed), draw its GIF (``gif=False`` keeps an existing one) and
     write ``<stem>.md`` beside it."""
-    from baselines.episode_gif import episode_gif
+    from baselines.figures.episode_gif import episode_gif
 
     if episodes < 1:
         raise ValueError(f"episodes: expected a positive integer, got {episodes!r}")
