@@ -28,6 +28,7 @@ import gymnasium as gym
 import numpy as np
 
 __all__ = [
+    "MOVED_MODULES",
     "ModelFileError",
     "TRUST_WARNING",
     "algorithm_from_data",
@@ -50,6 +51,13 @@ _RUNTIME_STATE = ("_last_obs", "_last_original_obs", "_last_episode_starts", "ep
 _SCHEDULES = ("lr_schedule", "learning_rate", "clip_range", "clip_range_vf")
 _CLASS_FIELDS = ("policy_class", "rollout_buffer_class", "replay_buffer_class")
 _KWARGS_FIELDS = ("policy_kwargs", "rollout_buffer_kwargs", "replay_buffer_kwargs")
+#: Modules of this project's model classes in files saved before they moved (the shipped
+#: models name them): old module -> today's, so those files still load.
+MOVED_MODULES = {
+    "baselines.agents.features": "baselines.models.features",  # old path
+    "baselines.agents.schedule_features": "baselines.models.schedule_features",  # old path
+    "baselines.agents.per_body": "baselines.models.per_body",  # old path
+}
 
 
 class ModelFileError(ValueError):
@@ -81,7 +89,10 @@ def allowed_classes() -> dict[str, type]:
         buffers.RolloutBuffer, buffers.DictRolloutBuffer, buffers.ReplayBuffer,
         buffers.DictReplayBuffer, HerReplayBuffer,
     ]  # fmt: skip
-    return {f"{c.__module__}.{c.__qualname__}": c for c in classes}
+    named = {f"{c.__module__}.{c.__qualname__}": c for c in classes}
+    moved = {f"{old}.{c.__qualname__}": c for old, new in MOVED_MODULES.items()
+             for c in classes if c.__module__ == new}  # fmt: skip
+    return named | moved
 
 
 def _fail(path: str, problem: str) -> ModelFileError:

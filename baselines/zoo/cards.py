@@ -23,7 +23,7 @@ from baselines.models.normalization import statistics_path
 
 __all__ = ["DOCS_IMAGES", "card_markdown", "machine", "recipe", "write_model_card"]
 
-DOCS_IMAGES = Path(__file__).resolve().parents[1] / "docs" / "images"
+DOCS_IMAGES = Path(__file__).resolve().parents[2] / "docs" / "images"
 
 
 def machine() -> str:
