@@ -4,7 +4,10 @@ Built on :mod:`sgc_env` (the arrows run one way: nothing in ``sgc_env`` imports 
 The harness, the agents and the ``sgc`` command live in subpackages.
 """
 
-from baselines.controllers.comparison_policies import DynamicConstraintsController, MinimumJerkController
+from baselines.controllers.comparison_policies import (
+    DynamicConstraintsController,
+    MinimumJerkController,
+)
 from baselines.controllers.expert import SGCExpert
 
 __all__ = ["DynamicConstraintsController", "MinimumJerkController", "SGCExpert"]

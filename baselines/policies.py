@@ -27,6 +27,7 @@ from typing import Any, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
+from baselines.common.shipped import resolve_policy_spec
 from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
     MinimumJerkController,
@@ -38,7 +39,6 @@ from baselines.controllers.comparison_policies import (
 from baselines.controllers.expert import SGCExpert
 from baselines.models.model_files import algorithm_from_data, load_sb3_model
 from baselines.models.normalization import load_statistics, statistics_path
-from baselines.common.shipped import resolve_policy_spec
 
 __all__ = [
     "BUILTIN_POLICIES",
@@ -190,7 +190,8 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 
 
 def vecnormalize_path(model_path: str | Path) -> Path | None:
-    """The ``VecNormalize`` statistics saved with a model (see :mod:`baselines.models.normalization`)."""
+    """The ``VecNormalize`` statistics saved with a model (see
+    :mod:`baselines.models.normalization`)."""
     return statistics_path(model_path)
 
 

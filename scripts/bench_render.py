@@ -87,9 +87,9 @@ def main() -> None:
     import gymnasium as gym
 
     import sgc_env  # noqa: F401  (registers the ids)
+    from baselines.controllers.expert import SGCExpert
     from baselines.figures.demo import DemoScene
     from baselines.figures.demo_camera import camera_at
-    from baselines.controllers.expert import SGCExpert
     from sgc_env.render import Painter, Trail
     from sgc_env.scenes import three_rods
     from sgc_env.simulator import pybullet as pb

@@ -19,9 +19,9 @@ import zipfile
 from pathlib import Path
 
 from baselines.common.atomic_files import write_atomic
-from baselines.zoo.manifest import CHECKPOINTS
 from baselines.models.model_files import read_model_data
 from baselines.models.normalization import convert_pickle
+from baselines.zoo.manifest import CHECKPOINTS
 
 #: Fields SB3 pickles from the last rollout; null in a converted zip.
 RUNTIME_FIELDS = ("_last_obs", "_last_original_obs", "_last_episode_starts",

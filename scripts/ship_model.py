@@ -21,8 +21,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from baselines.zoo.manifest import CHECKPOINTS, held_out_result, ship_model, write_entry
 from baselines.zoo.cards import write_model_card
+from baselines.zoo.manifest import CHECKPOINTS, held_out_result, ship_model, write_entry
 
 
 def main() -> None:

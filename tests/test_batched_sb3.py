@@ -111,7 +111,10 @@ def test_adapter_refuses_bad_input() -> None:
 @pytest.mark.parametrize("policy", ["dc", "mj"])
 def test_comparison_policies_run_on_the_batched_env(policy: str) -> None:
     """They read each sub-env's scenario through ``envs`` (baselines.common.sub_envs.sub_env)."""
-    from baselines.controllers.comparison_policies import DynamicConstraintsController, MinimumJerkController
+    from baselines.controllers.comparison_policies import (
+        DynamicConstraintsController,
+        MinimumJerkController,
+    )
 
     cls = DynamicConstraintsController if policy == "dc" else MinimumJerkController
     runs = []

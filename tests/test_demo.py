@@ -11,11 +11,11 @@ import pytest
 import yaml
 
 import sgc_env
+from baselines.cli.main import main
+from baselines.controllers.expert import SGCExpert
+from baselines.evaluation.harness import run_episode
 from baselines.figures.demo import DemoOptions, DemoScene, gif_durations, pierce_times
 from baselines.figures.demo_camera import DEMO_SHOTS, camera_at
-from baselines.cli.main import main
-from baselines.evaluation.harness import run_episode
-from baselines.controllers.expert import SGCExpert
 from sgc_env.paper.frames import normalized_frame
 from sgc_env.scenario.load import builtin_path
 from sgc_env.scenes import three_rods

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import sgc_env
-from baselines.evaluation.harness import evaluate
 from baselines.controllers.expert import SGCExpert
+from baselines.evaluation.harness import evaluate
 from baselines.policies import EpisodeExpert, make_policy
 from sgc_env.paper.frames import K_MIN, PACE_STEP, course_end_velocity, tangent_speed
 from sgc_env.paper.plan import BodyState, PlanOptions, PositionGoal, plan_body

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import sgc_env
-from baselines.evaluation.harness import goal_rows, run_episode
 from baselines.controllers.expert import SGCExpert
+from baselines.evaluation.harness import goal_rows, run_episode
 
 EXACT = 1e-9
 RANDOM_SEEDS = 100  # per random env: SGCPoint-v0 and SGCRod-v0 give 200 scenarios

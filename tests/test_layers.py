@@ -68,7 +68,9 @@ def test_import_sgc_env_loads_no_baselines_no_planner_no_scipy():
 
 def test_the_detector_sees_a_lazy_upward_import(tmp_path):
     module = tmp_path / "lazy.py"
-    module.write_text("def f():\n    from baselines.controllers.expert import SGCExpert\n    return 1\n")
+    module.write_text(
+        "def f():\n    from baselines.controllers.expert import SGCExpert\n    return 1\n"
+    )
     assert "baselines.controllers.expert" in _imported_modules(module)
 
 

@@ -10,6 +10,7 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
+from baselines.cli import main as cli  # noqa: E402
 from baselines.zoo.manifest import (  # noqa: E402
     CHECKPOINTS,
     ENTRY_FIELDS,
@@ -19,7 +20,6 @@ from baselines.zoo.manifest import (  # noqa: E402
     steps_trained,
     write_entry,
 )
-from baselines.cli import main as cli  # noqa: E402
 
 ENTRIES = load_manifest()
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import sgc_env  # noqa: F401  (registers the ids)
-from baselines.evaluation.harness import evaluate
 from baselines.controllers.expert import SGCExpert, substep_lag
 from baselines.controllers.matched_table import course_key, matched_table
+from baselines.evaluation.harness import evaluate
 from sgc_env.paper.frames import course_end_velocity, solve_course_in_frame
 from sgc_env.paper.hermite import RestQuarticProfile
 from sgc_env.paper.matched import matched_end_velocities

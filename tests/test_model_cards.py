@@ -5,9 +5,9 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from baselines.zoo.manifest import CHECKPOINTS, load_manifest
 from baselines.cli.main import main
 from baselines.zoo.cards import card_markdown, recipe
+from baselines.zoo.manifest import CHECKPOINTS, load_manifest
 
 ROOT = Path(__file__).resolve().parents[1]
 SECTIONS = ("**Env**", "**Algorithm**", "**Recipe**", "**Training seed**",

@@ -18,6 +18,8 @@ from stable_baselines3 import PPO  # noqa: E402
 
 import sgc_env  # noqa: E402
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
+from baselines.evaluation.harness import evaluate  # noqa: E402
+from baselines.models.model_files import load_sb3_model  # noqa: E402
 from baselines.models.per_body import (  # noqa: E402
     BODY_ACTIONS,
     BODY_FEATURES,
@@ -25,8 +27,6 @@ from baselines.models.per_body import (  # noqa: E402
     PerBodyPolicy,
     body_gains,
 )
-from baselines.evaluation.harness import evaluate  # noqa: E402
-from baselines.models.model_files import load_sb3_model  # noqa: E402
 from sgc_env.observation import BODY_BLOCK_SIZE  # noqa: E402
 
 RECIPE = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams" / "ppo_threerod"

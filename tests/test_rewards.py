@@ -8,11 +8,14 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import sgc_env
-from baselines.controllers.actuation import wrench_for_targets
-from baselines.controllers.comparison_policies import DynamicConstraintsController, MinimumJerkController
 from baselines.common.env_model import EnvModel
-from baselines.controllers.expert import SGCExpert
 from baselines.common.observation_fields import read_body
+from baselines.controllers.actuation import wrench_for_targets
+from baselines.controllers.comparison_policies import (
+    DynamicConstraintsController,
+    MinimumJerkController,
+)
+from baselines.controllers.expert import SGCExpert
 from baselines.policies import make_policy
 from sgc_env.envs.rewards import REWARD_MODES
 

@@ -16,8 +16,8 @@ import torch as th  # noqa: E402
 
 import sgc_env  # noqa: E402, F401
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
-from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
 from baselines.agents.train import TrainConfig, train  # noqa: E402
+from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
 from sgc_env.envs.rewards import TRACK_COST_CAP, schedule_cost, tracks_of  # noqa: E402
 
 BENCHMARK_HP = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams"

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import sgc_env  # noqa: F401  (registers the ids)
-from baselines.evaluation.harness import evaluate
 from baselines.controllers.expert import SGCExpert
 from baselines.controllers.matched_table import course_key, course_row
 from baselines.controllers.smooth_table import LONGEST_SUBCOURSE, smooth_table
+from baselines.evaluation.harness import evaluate
 from sgc_env.paper import quaternion as quat
 
 GOAL_TOLERANCE = 1e-9

@@ -16,8 +16,8 @@ from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
 import sgc_env  # noqa: F401  (registers the ids)
 from baselines import SGCExpert
-from baselines.policies import make_policy
 from baselines.common.sub_envs import base_env
+from baselines.policies import make_policy
 
 
 def _two(kind: type) -> Callable[[str], Any]:

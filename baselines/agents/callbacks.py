@@ -201,7 +201,8 @@ class FreezeActorCallback(BaseCallback):
 
 class StatisticsCheckpointCallback(CheckpointCallback):
     """SB3's ``CheckpointCallback`` with the ``VecNormalize`` statistics in JSON
-    (``<prefix>_vecnormalize_<N>_steps.json``, :mod:`baselines.models.normalization`), not a pickle."""
+    (``<prefix>_vecnormalize_<N>_steps.json``, :mod:`baselines.models.normalization`), not a
+    pickle."""
 
     def __init__(self, save_freq: int, save_path: str, name_prefix: str = "rl_model",
                  save_vecnormalize: bool = False) -> None:  # fmt: skip

@@ -16,9 +16,9 @@ from typing import Any
 
 import yaml
 
-from baselines.models.features import ACTIVATIONS
 from baselines.common.shipped import hyperparams_file
 from baselines.common.value_types import describe, matches
+from baselines.models.features import ACTIVATIONS
 
 __all__ = [
     "ALGORITHMS",

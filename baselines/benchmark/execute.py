@@ -17,8 +17,8 @@ import traceback
 from pathlib import Path
 from typing import Any
 
-from baselines.common.atomic_files import write_atomic
 from baselines.benchmark.grid import RunSpec, train_command
+from baselines.common.atomic_files import write_atomic
 
 __all__ = ["FAILED_FILE", "RESULT_FILE", "execute_run", "write_outcome"]
 

@@ -199,7 +199,8 @@ def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[
 
 
 def add_trust_argument(parser: argparse.ArgumentParser) -> None:
-    """``--trust-model``: load model files with SB3's unpickling (see baselines.models.model_files)."""
+    """``--trust-model``: load model files with SB3's unpickling (see
+    baselines.models.model_files)."""
     parser.add_argument(
         "--trust-model", action="store_true",
         help="unpickle model files (.zip fields, .vecnormalize.pkl) as SB3 does: a file can "

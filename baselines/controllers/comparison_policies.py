@@ -1,8 +1,8 @@
 """The two comparison baselines as SB3-style policies on the env's observation.
 
 Both turn a next-tick target into a force and torque through :func:`wrench_for_targets`, the
-same deadbeat actuation as :class:`~baselines.controllers.expert.SGCExpert`, so the three differ *only* in
-how they choose targets:
+same deadbeat actuation as :class:`~baselines.controllers.expert.SGCExpert`, so the three differ
+*only* in how they choose targets:
 
 - :class:`DynamicConstraintsController` (Barzel & Barr 1988): every deviation component
   decays by the critically damped law; a goal is met when |D| < eps and the controller then
@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from baselines.controllers.actuation import wrench_for_targets
-from baselines.controllers.dynamic_constraints import DynamicConstraintsCourse, choose_tau
 from baselines.common.env_model import EnvModel
-from baselines.controllers.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 from baselines.common.observation_fields import BodyObservation, read_body
 from baselines.common.sub_envs import base_env, sub_env
+from baselines.controllers.actuation import wrench_for_targets
+from baselines.controllers.dynamic_constraints import DynamicConstraintsCourse, choose_tau
+from baselines.controllers.minimum_jerk import MinimumJerkPath, MinimumJerkRotation
 from sgc_env.metrics import goals_from_scenario
 from sgc_env.paper.orientation import left_jacobian_inverse
 from sgc_env.paper.quaternion import unwrap_rotvec

@@ -3,9 +3,10 @@
 Every control step the expert re-plans the rest of the current course from the measured state
 (the SGC family is time-consistent, so with nothing disturbing the body this *is* the plan
 made at the course start) and then chooses the force and torque that land the body exactly on
-the plan's next sample, through the known PyBullet integrator (:mod:`baselines.controllers.tracking`). On
-the tick that reaches a goal the next sample is the goal itself, so goals are met to floating
-point. A push mid-course simply becomes a new measured state to re-plan from.
+the plan's next sample, through the known PyBullet integrator
+(:mod:`baselines.controllers.tracking`). On the tick that reaches a goal the next sample is the goal
+itself, so goals are met to floating point. A push mid-course simply becomes a new measured state to
+re-plan from.
 
 The policy reads only the observation (plus the env's constants in :class:`EnvModel`), so it
 runs inside ``evaluate_policy``, vector envs and imitation tools.
@@ -19,12 +20,17 @@ from typing import Any
 
 import numpy as np
 
-from baselines.controllers.actuation import body_wrench
 from baselines.common.env_model import BodyModel, EnvModel
-from baselines.controllers.matched_table import EXPERT_RULES, MatchedTable, course_key, matched_table
 from baselines.common.observation_fields import COURSE_SIZE, BodyFields, TrackFields
-from baselines.controllers.smooth_table import SmoothCourse, SmoothTable, smooth_table
 from baselines.common.sub_envs import base_env
+from baselines.controllers.actuation import body_wrench
+from baselines.controllers.matched_table import (
+    EXPERT_RULES,
+    MatchedTable,
+    course_key,
+    matched_table,
+)
+from baselines.controllers.smooth_table import SmoothCourse, SmoothTable, smooth_table
 from sgc_env.paper import quaternion as quat
 from sgc_env.paper.frames import course_end_velocity, next_deviation
 from sgc_env.paper.orientation import left_jacobian_inverse_apply
@@ -61,10 +67,11 @@ class SGCExpert:
         """``end_rule``: how interior courses end, ``"tangent"`` or ``"paper"`` (eqs. 12-14,
         :mod:`sgc_env.paper.frames`), ``"matched"`` (:mod:`sgc_env.paper.matched`:
         accelerations matched over whole tracks) or ``"smooth"`` (SGC sub-courses between
-        transient sub-goals on the minimum-jerk reference, :mod:`baselines.controllers.smooth_table`);
-        None follows the scenario (``model.end_rule``). ``"matched"`` and ``"smooth"`` read the
-        episode's scenario (``scenario``, else ``env``'s current one, re-read when a course is
-        not found) and look every course up in their table (:mod:`baselines.controllers.matched_table`,
+        transient sub-goals on the minimum-jerk reference,
+        :mod:`baselines.controllers.smooth_table`); None follows the scenario (``model.end_rule``).
+        ``"matched"`` and ``"smooth"`` read the episode's scenario (``scenario``, else ``env``'s
+        current one, re-read when a course is not found) and look every course up in their table
+        (:mod:`baselines.controllers.matched_table`,
         :mod:`baselines.controllers.smooth_table`); a course they do not know (a state of another
         scenario) ends by the tangent rule.
 
@@ -273,9 +280,9 @@ def _toward_subgoal(
 ) -> tuple[tuple, float, tuple, tuple, tuple]:
     """The deviation from the next sub-goal, the time to it, the frame of its sub-course, the
     reference's velocity there and the sub-course's planned rate now
-    (:mod:`baselines.controllers.smooth_table`). Deviations are measured from the reference's sub-goal
-    (for a rotation its principal log: the env's unwrapped deviation can take the other way
-    round than the reference), but on the tick that reaches a real goal the env's deviation
+    (:mod:`baselines.controllers.smooth_table`). Deviations are measured from the reference's
+    sub-goal (for a rotation its principal log: the env's unwrapped deviation can take the other
+    way round than the reference), but on the tick that reaches a real goal the env's deviation
     is kept, so the goal is met exactly."""
     sub = course.subgoals
     now = course.end_tick - round(time_left / period)

@@ -23,8 +23,8 @@ __all__ = ["EXPERT_RULES", "course_key", "course_row", "matched_table"]
 
 EXPERT_RULES: tuple[str, ...] = ("tangent", "paper", "matched", "smooth")
 """End rules the expert plays: the scenario's two (:data:`sgc_env.paper.end_rules.END_RULES`)
-and ``"matched"`` and ``"smooth"`` (:mod:`baselines.controllers.smooth_table`), which need the scenario's
-whole tracks."""
+and ``"matched"`` and ``"smooth"`` (:mod:`baselines.controllers.smooth_table`), which need the
+scenario's whole tracks."""
 
 MatchedTable = dict[tuple[float, ...], tuple[tuple[float, float, float], bool]]
 """Course key -> (end velocity, whether it was solved rather than the tangent rule's)."""

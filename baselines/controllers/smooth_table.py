@@ -20,13 +20,13 @@ change of pace, where an SGC course through a few ticks bends away from the spli
 one tick (then the course is the reference's next sample). One tick's change of acceleration
 along the expert's plan is then about the reference's plus at most twice the tolerance.
 
-The expert (:class:`baselines.controllers.expert.SGCExpert`, ``end_rule="smooth"``) re-solves the current
-sub-course every tick from the measured deviation from its sub-goal and the sub-course's
+The expert (:class:`baselines.controllers.expert.SGCExpert`, ``end_rule="smooth"``) re-solves the
+current sub-course every tick from the measured deviation from its sub-goal and the sub-course's
 planned rate (:meth:`SubGoals.planned_rate`), and lands every tick's rotation by the exact
 Newton step; docs/smoothness.md has the measurements behind both choices.
 
-The table is keyed like the matched rule's (:mod:`baselines.controllers.matched_table`): body, track and
-the course's float32 observation entries, so a stateless expert finds its course from any
+The table is keyed like the matched rule's (:mod:`baselines.controllers.matched_table`): body, track
+and the course's float32 observation entries, so a stateless expert finds its course from any
 state of the episode; courses of another scenario are not found.
 """
 

@@ -3,8 +3,8 @@
 ``evaluate(policy, env_id, episodes, seed)`` runs episode k with ``reset(seed=seed + k)``,
 keeps the reset info and every step's info, scores each episode with
 :func:`sgc_env.metrics.score_episode` against :func:`goals_from_scenario` of the scenario the
-episode actually ran (:mod:`baselines.evaluation.episodes`), and aggregates. ``num_envs`` > 1 runs the
-episodes on that many sub-envs of the batched env at once, with the same episodes. It imports
+episode actually ran (:mod:`baselines.evaluation.episodes`), and aggregates. ``num_envs`` > 1 runs
+the episodes on that many sub-envs of the batched env at once, with the same episodes. It imports
 neither torch nor SB3 (only a model path spec does, through
 :func:`baselines.policies.make_policy`), so a training callback can call it with the model
 object itself on held-out seeds.

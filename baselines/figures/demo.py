@@ -335,7 +335,11 @@ def _per_rod(
 
 
 def _plots(record: Any, scenario: Any, out: Path) -> dict[str, Path]:
-    from baselines.figures.plots import plot_deviation_components, plot_speed_profile, trajectory_arrays
+    from baselines.figures.plots import (
+        plot_deviation_components,
+        plot_speed_profile,
+        trajectory_arrays,
+    )
 
     traj = trajectory_arrays(record.infos, record.initial_info)
     names = [b.name for b in scenario.bodies]

@@ -35,8 +35,8 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
-from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
 from baselines.common.env_model import EnvModel
+from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
 
 __all__ = [
     "BODY_ACTIONS",

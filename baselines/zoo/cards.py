@@ -18,8 +18,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from baselines.zoo.manifest import CHECKPOINTS, held_out_result, load_manifest
 from baselines.models.normalization import statistics_path
+from baselines.zoo.manifest import CHECKPOINTS, held_out_result, load_manifest
 
 __all__ = ["DOCS_IMAGES", "card_markdown", "machine", "recipe", "write_model_card"]
 

@@ -121,9 +121,9 @@ def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+    from baselines.evaluation.harness import write_summary_json
     from baselines.figures.demo import ENV_ID, cpu_seconds, run_demo
     from baselines.figures.demo_compare import write_side_by_side
-    from baselines.evaluation.harness import write_summary_json
 
     console = Console()
     started = time.perf_counter()
