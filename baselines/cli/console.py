@@ -1,14 +1,24 @@
-"""Presentation shared by the commands: help with defaults, the one-line result summary, and
-a console sized to the person's terminal."""
+"""Presentation shared by the commands: help with defaults, the one-line result summary, a
+console sized to the person's terminal, and the scorecard tables printed on it."""
 
 from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-__all__ = ["DefaultsHelpFormatter", "make_console", "summary_line"]
+__all__ = [
+    "COMPACT_COLUMNS",
+    "DefaultsHelpFormatter",
+    "SMOOTHNESS_COLUMNS",
+    "SMOOTHNESS_WIDE_COLUMNS",
+    "goal_table",
+    "goals_met_line",
+    "make_console",
+    "scorecard_table",
+    "summary_line",
+]
 
 WIDE_WIDTH = 240
 """Console width of ``--wide`` output (lines longer than the terminal wrap, cells stay whole)."""
@@ -53,3 +63,98 @@ def summary_line(summary: Mapping[str, Any]) -> str:
     if summary.get("terminated"):
         text += f", {int(summary['terminated'])} episode(s) failed (left the workspace or diverged)"
     return text
+
+
+#: The default table, readable at 80 columns (``--wide``: every column of
+#: :data:`baselines.evaluation.scorecards.SCORECARD_COLUMNS`).
+COMPACT_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("success_rate", "success", ".2f"),
+    ("position_error_max", "pos err\nmax (m)", ".1e"),
+    ("orientation_error_max", "ori err\nmax (rad)", ".1e"),
+    ("position_closest_offset_abs_max", "offset\nmax (s)", ".3f"),
+)
+
+#: The smoothness table printed under the compact one: LDLJ over the whole track and the
+#: largest one-tick change of acceleration (the kink), linear and angular (peaks: ``--wide``).
+SMOOTHNESS_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("env_id", "env", "s"),
+    ("policy", "policy", "s"),
+    ("ldlj_track_mean", "LDLJ\ntrack", ".2f"),
+    ("acceleration_kink_max", "kink\n(m/s²)", ".2f"),
+    ("angular_ldlj_track_mean", "ang LDLJ\ntrack", ".2f"),
+    ("angular_acceleration_kink_max", "ang kink\n(rad/s²)", ".2f"),
+)
+
+#: The smoothness table with ``--wide``: peaks and the angular velocity jump too.
+SMOOTHNESS_WIDE_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    *SMOOTHNESS_COLUMNS[:4],
+    ("acceleration_peak_max", "peak acc\n(m/s²)", ".1f"),
+    *SMOOTHNESS_COLUMNS[4:],
+    ("angular_acceleration_peak_max", "peak ang acc\n(rad/s²)", ".1f"),
+    ("angular_velocity_jump_max", "ang vel jump\nmax (rad/s)", ".3f"),
+)
+
+#: Per-goal table of a single pair: (row key, full title, compact title, format).
+GOAL_TABLE_COLUMNS: tuple[tuple[str, str, str, str], ...] = (
+    ("body", "body", "body", "d"),
+    ("goal", "goal", "goal", "d"),
+    ("time", "time", "time", ".3f"),
+    ("position_error", "position_error", "pos err", ".2e"),
+    ("orientation_error", "orientation_error", "ori err", ".2e"),
+    ("closest_approach_offset", "closest_approach_offset", "closest", "+.3f"),
+    ("entry_offset", "entry_offset", "entry", "+.3f"),
+    ("success", "success", "ok", "s"),
+)
+
+
+def _table(title: str, wide: bool) -> Any:
+    from rich import box
+    from rich.table import Table
+
+    if wide:
+        return Table(title=title, box=box.SQUARE)
+    return Table(title=title, box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
+
+
+def scorecard_table(
+    summaries: Sequence[Mapping[str, Any]],
+    title: str,
+    wide: bool = False,
+    columns: Sequence[tuple[str, str, str]] | None = None,
+) -> Any:
+    """A Rich table of scorecards, one row each (``columns``: by default compact or wide)."""
+    from baselines.evaluation.scorecards import SCORECARD_COLUMNS, format_cell
+
+    table = _table(title, wide)
+    if columns is None:
+        columns = SCORECARD_COLUMNS if wide else COMPACT_COLUMNS
+    for _, name, fmt in columns:
+        text = fmt == "s"
+        table.add_column(name, justify="left" if text else "right", overflow="fold")
+    for s in summaries:
+        table.add_row(*(format_cell(s.get(k), f) for k, _, f in columns))
+    return table
+
+
+def goal_table(rows: Sequence[Mapping[str, Any]], wide: bool = False, limit: int = 40) -> Any:
+    """The first episode's goals of one pair, one row each."""
+    from baselines.evaluation.scorecards import format_cell
+
+    table = _table("episode 0, per goal", wide)
+    for _, full, short, _ in GOAL_TABLE_COLUMNS:
+        table.add_column(full if wide else short, justify="right")
+    for row in [r for r in rows if r["episode"] == 0][:limit]:
+        table.add_row(*(format_cell(row[key], fmt) for key, _, _, fmt in GOAL_TABLE_COLUMNS))
+    return table
+
+
+def goals_met_line(summaries: Sequence[Mapping[str, Any]]) -> str:
+    """Goals met per policy, summed over the envs: the comparison in one line."""
+    met: dict[str, list[int]] = {}
+    for s in summaries:
+        counts = met.setdefault(str(s["policy"]), [0, 0])
+        counts[0] += int(s.get("goals_met", 0))
+        counts[1] += int(s.get("n_goals", 0))
+    return "goals met: " + ", ".join(f"{p} {m}/{n}" for p, (m, n) in met.items())

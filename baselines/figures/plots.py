@@ -287,3 +287,14 @@ def plot_method_comparison(
             _mark_goals(ax, times)
     fig.suptitle(title or f"body {body}: dynamic constraints vs sequential-goal constraints")
     return _save(fig, path)
+
+
+def plot_evaluation(result: Any, folder: Path) -> None:
+    """``goal_errors.png`` and (from episode 0's infos) ``speed_profile.png`` of one
+    harness result (:class:`~baselines.evaluation.harness.EvaluationResult`)."""
+    title = f"{result.policy} on {result.env_id}"
+    plot_goal_errors(result.rows, folder / "goal_errors.png", title=title)
+    first = result.episodes[0]
+    if first.infos:
+        traj = trajectory_arrays(first.infos, first.initial_info)
+        plot_speed_profile(traj, first.goals, folder / "speed_profile.png", title=f"{title}, ep 0")
