@@ -1,5 +1,6 @@
 """Presentation shared by the commands: help with defaults, the one-line result summary, a
-console sized to the person's terminal, and the scorecard tables printed on it."""
+console sized to the person's terminal, the scorecard tables printed on it, and the progress
+of a benchmark's runs."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from typing import Any
 __all__ = [
     "COMPACT_COLUMNS",
     "DefaultsHelpFormatter",
+    "RunProgress",
     "SMOOTHNESS_COLUMNS",
     "SMOOTHNESS_WIDE_COLUMNS",
     "goal_table",
@@ -158,3 +160,56 @@ def goals_met_line(summaries: Sequence[Mapping[str, Any]]) -> str:
         counts[0] += int(s.get("goals_met", 0))
         counts[1] += int(s.get("n_goals", 0))
     return "goals met: " + ", ".join(f"{p} {m}/{n}" for p, (m, n) in met.items())
+
+
+class RunProgress:
+    """A progress bar over a benchmark's runs (a line per outcome in a pipe); its methods are
+    :func:`baselines.benchmark.driver.run_grid`'s callbacks."""
+
+    def __init__(self, console: Any, total: int) -> None:
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+        )
+
+        self.console = console
+        self.counts = {"running": 0, "done": 0, "failed": 0}
+        columns = (TextColumn("[bold]runs"), BarColumn(), MofNCompleteColumn(),
+                   TextColumn("{task.description}"), TimeElapsedColumn())  # fmt: skip
+        self.progress = Progress(*columns, console=console, disable=not console.is_terminal)
+        self.task = self.progress.add_task(self._status(), total=total)
+
+    def __enter__(self) -> RunProgress:
+        self.progress.__enter__()
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.progress.__exit__(*exc)
+
+    def _status(self) -> str:
+        c = self.counts
+        return f"done {c['done']}, running {c['running']}, failed {c['failed']}"
+
+    def started(self, run_id: str) -> None:
+        self.counts["running"] += 1
+        self.progress.update(self.task, description=self._status())
+
+    def finished(self, outcome: Mapping[str, Any], folder: Any) -> None:
+        ok = outcome["status"] == "finished"
+        self.counts["running"] -= 1
+        self.counts["done" if ok else "failed"] += 1
+        line = f"{outcome['run_id']}: {'finished' if ok else 'FAILED'} in "
+        line += f"{outcome['wall_time_s']:.0f} s"
+        if not ok:
+            line += f" ({outcome['error']}; see {folder}/failed.json)"
+        if self.console.is_terminal:
+            self.progress.console.print(line)
+        else:
+            print(line, flush=True)
+        self.progress.update(self.task, advance=1, description=self._status())
+
+    def elsewhere(self, run_id: str) -> None:
+        self.progress.update(self.task, advance=1)
