@@ -15,6 +15,7 @@ __all__ = [
     "RunProgress",
     "SMOOTHNESS_COLUMNS",
     "SMOOTHNESS_WIDE_COLUMNS",
+    "demo_scorecard_table",
     "goal_table",
     "goals_met_line",
     "make_console",
@@ -213,3 +214,33 @@ class RunProgress:
 
     def elsewhere(self, run_id: str) -> None:
         self.progress.update(self.task, advance=1)
+
+
+def demo_scorecard_table(option: Any, result: Any) -> Any:
+    """The per-rod scorecard of one run of ``sgc demo``, as a rich table."""
+    from rich.table import Table
+
+    if option.policy == "expert":
+        rule = "the paper's k rules" if option.end_rule == "paper" else "the tangent rule"
+        who = f"the expert ({rule})"
+    else:
+        who = f"policy {result.label}"
+    table = Table(title=f"three-rod demo: {who}, scored by the harness")
+    table.add_column("rod", no_wrap=True)
+    for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
+                   "SPARC", "min speed at goals / avg", "kink (m/s²)",
+                   "ang kink (rad/s²)"):  # fmt: skip
+        table.add_column(column, justify="right")
+    for rod in result.per_rod:
+        table.add_row(
+            rod["rod"], str(rod["goals"]), str(rod["goals_met"]),
+            _fmt(rod["position_error_max_m"]), _fmt(rod["orientation_error_max_rad"]),
+            _fmt(rod["closest_approach_offset_max_s"]), _fmt(rod["sparc_track"], ".2f"),
+            _fmt(rod["goal_speed_ratio_min"], ".2f"), _fmt(rod["acceleration_kink"], ".1f"),
+            _fmt(rod["angular_acceleration_kink"], ".1f"),
+        )  # fmt: skip
+    return table
+
+
+def _fmt(value: float | None, spec: str = ".1e") -> str:
+    return "-" if value is None else format(value, spec)
