@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from baselines.cli.commands.train import whole_rollouts
+from baselines.agents.budget import whole_rollouts
+from baselines.agents.hyperparams import load_hyperparams
 from baselines.cli.console import summary_line
 from baselines.cli.main import build_parser, main
 
@@ -45,10 +46,10 @@ def test_summary_line_reads_flattened_histories() -> None:
 
 @pytest.mark.parametrize(
     ("algo", "asked", "trained"),
-    [("ppo", 5000, 6144), ("ppo", 2048, 2048), ("sac", 1001, 1001), ("ppo", None, None)],
+    [("ppo", 5000, 6144), ("ppo", 2048, 2048), ("sac", 1001, 1001), ("ppo", 0, 0)],
 )
 def test_timesteps_round_up_to_whole_rollouts(algo, asked, trained) -> None:
-    assert whole_rollouts(algo, "SGCPoint-v0", asked, None) == trained
+    assert whole_rollouts(asked, algo, load_hyperparams(algo, "SGCPoint-v0")) == trained
 
 
 def _help(command: str, capsys: pytest.CaptureFixture[str]) -> str:

@@ -18,7 +18,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
+from baselines.agents.hyperparams import ALGORITHMS, Hyperparams, algorithm_class
 from baselines.agents.pushes import Pushes
 from baselines.common.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
@@ -29,6 +29,7 @@ __all__ = [
     "TrainResult",
     "algorithm_class",
     "load_model",
+    "record_run_folder",
     "train",
 ]
 
@@ -141,8 +142,11 @@ def _jsonable(value: Any) -> Any:
     return getattr(value, "__name__", repr(value))
 
 
-def train(cfg: TrainConfig) -> TrainResult:
-    """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
+def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
+    """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`).
+
+    ``hp``: the hyperparameters of ``cfg`` when the caller has parsed them already (they are
+    parsed once per run); None reads them from ``cfg.hyperparams_dir``."""
     import torch as th
     from stable_baselines3.common.callbacks import BaseCallback, CallbackList
     from stable_baselines3.common.utils import set_random_seed
@@ -160,7 +164,8 @@ def train(cfg: TrainConfig) -> TrainResult:
     _validate(cfg)
     started = time.perf_counter()
     th.set_num_threads(1)
-    hp = load_hyperparams(cfg.algo, cfg.env_id, cfg.hyperparams_dir)
+    if hp is None:
+        hp = load_hyperparams(cfg.algo, cfg.env_id, cfg.hyperparams_dir)
     total = hp.n_timesteps if cfg.timesteps is None else int(cfg.timesteps)
     set_random_seed(cfg.seed)
     env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs, cfg.vec)
@@ -278,6 +283,15 @@ def train(cfg: TrainConfig) -> TrainResult:
         (out / "config.json").write_text(json.dumps(_jsonable(config), indent=1))
     env.close()
     return result
+
+
+def record_run_folder(written: Path, out: Path) -> None:
+    """Let ``config.json``, written in folder ``written``, name the run folder ``out`` (a
+    run staged elsewhere and moved in)."""
+    config = written / "config.json"
+    data = json.loads(config.read_text())
+    data["train_config"]["out"] = str(out)
+    config.write_text(json.dumps(data, indent=1))
 
 
 def _clone(model: Any, cfg: TrainConfig, deadline: float | None = None) -> dict[str, Any]:

@@ -1,6 +1,6 @@
 """Presentation shared by the commands: help with defaults, the one-line result summary, a
 console sized to the person's terminal, the scorecard tables printed on it, and the progress
-of a benchmark's runs."""
+of a benchmark's runs; what a training run did."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ __all__ = [
     "goal_table",
     "goals_met_line",
     "make_console",
+    "print_training",
     "scorecard_table",
     "summary_line",
 ]
@@ -244,3 +245,30 @@ def demo_scorecard_table(option: Any, result: Any) -> Any:
 
 def _fmt(value: float | None, spec: str = ".1e") -> str:
     return "-" if value is None else format(value, spec)
+
+
+def print_training(result: Any, cfg: Any, out: Any) -> None:
+    """What ``sgc train`` did: steps, times, cloning, the model file and the last evaluation
+    (``result``: a :class:`~baselines.agents.train.TrainResult` of ``cfg``; ``out``: its folder)."""
+    if cfg.time_budget_s is not None:
+        spent = "spent" if result.config["budget_spent"] else "not spent"
+        print(f"time budget {cfg.time_budget_s:g} s {spent}: {result.timesteps} steps reached "
+              f"in {result.config['train_time_s']:.1f} s of training")  # fmt: skip
+    print(
+        f"{cfg.algo} on {cfg.env_id}: {result.timesteps} steps, learn {result.learn_time_s:.1f} s "
+        f"({result.steps_per_s:.0f} steps/s), total {result.wall_time_s:.1f} s"
+    )
+    if result.bc:
+        print(f"bc: loss {result.bc['loss_before']:.4g} -> {result.bc['loss_after']:.4g}")
+    if result.model_path is not None:
+        print(f"model: {result.model_path}")
+    if result.evaluations:
+        last = result.evaluations[-1]
+        where = f"; every entry in {out}/evaluations.json" if out else ""
+        print(
+            f"evaluation at {last['timesteps']} steps ({cfg.eval_episodes} episodes from seed "
+            f"{cfg.eval_seed}{where}):\n{summary_line(last)}"
+        )
+    else:
+        print("not evaluated (add --eval-freq N or --eval-every-s S to score the model with the "
+              "harness)")  # fmt: skip
