@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
@@ -42,6 +42,8 @@ from baselines.models.normalization import load_statistics, statistics_path
 
 __all__ = [
     "BUILTIN_POLICIES",
+    "POLICY_FACTORIES",
+    "BuiltinPolicy",
     "EpisodeExpert",
     "NormalizedPolicy",
     "Policy",
@@ -55,10 +57,6 @@ __all__ = [
     "vecnormalize_path",
 ]
 
-BUILTIN_POLICIES: tuple[str, ...] = (
-    "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
-    "minimum-jerk", "random",
-)  # fmt: skip
 _TRUST_MODELS: contextvars.ContextVar[bool] = contextvars.ContextVar("trust_models", default=False)
 
 
@@ -244,6 +242,34 @@ def _one_torch_thread() -> None:
     torch.set_num_threads(1)
 
 
+class BuiltinPolicy(NamedTuple):
+    """How to make a built-in policy: ``make(env, seed)``; ``flat``: it reads the flat SGC
+    observation, so the env is checked for one first."""
+
+    make: Callable[[Any, int | None], Policy]
+    flat: bool = True
+
+
+def _expert(end_rule: str | None) -> BuiltinPolicy:
+    return BuiltinPolicy(lambda env, seed: EpisodeExpert(env, end_rule=end_rule))
+
+
+POLICY_FACTORIES: dict[str, BuiltinPolicy] = {
+    "expert": _expert(None),
+    "expert-paper": _expert("paper"),
+    "expert-matched": _expert("matched"),
+    "expert-smooth": _expert("smooth"),
+    "dynamic-constraints": BuiltinPolicy(lambda env, seed: DynamicConstraintsController(env)),
+    "minimum-jerk": BuiltinPolicy(lambda env, seed: MinimumJerkController(env)),
+    "random": BuiltinPolicy(
+        lambda env, seed: RandomPolicy(_spaces_env(env).action_space, seed), flat=False
+    ),
+}
+"""The built-in policies by name: the one list of them."""
+
+BUILTIN_POLICIES: tuple[str, ...] = tuple(POLICY_FACTORIES)
+
+
 def make_policy(
     spec: str, env: Any, seed: int | None = None, trust_model: bool | None = None
 ) -> Policy:
@@ -255,24 +281,11 @@ def make_policy(
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
     spec = resolve_policy_spec(spec)
-    if spec == "random":
-        return RandomPolicy(_spaces_env(env).action_space, seed)
-    if spec in (
-        "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
-        "minimum-jerk",
-    ):  # fmt: skip
-        _needs_flat_observation(env, spec)
-        if spec == "expert":
-            return EpisodeExpert(env)
-        if spec == "expert-paper":
-            return EpisodeExpert(env, end_rule="paper")
-        if spec == "expert-matched":
-            return EpisodeExpert(env, end_rule="matched")
-        if spec == "expert-smooth":
-            return EpisodeExpert(env, end_rule="smooth")
-        if spec == "dynamic-constraints":
-            return DynamicConstraintsController(env)
-        return MinimumJerkController(env)
+    builtin = POLICY_FACTORIES.get(spec)
+    if builtin is not None:
+        if builtin.flat:
+            _needs_flat_observation(env, spec)
+        return builtin.make(env, seed)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
         trust = _TRUST_MODELS.get() if trust_model is None else trust_model
         single = _spaces_env(env)
