@@ -65,7 +65,7 @@ class Policy(Protocol):
     """What the harness, the CLI and training callbacks drive: SB3's ``predict`` signature.
 
     The expert, the comparison controllers, :class:`RandomPolicy`, :class:`EpisodeExpert`,
-    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/test_policies.py``).
+    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/baselines/test_policies.py``).
     SB3 models default to ``deterministic=False``; the harness always passes True.
     """
 

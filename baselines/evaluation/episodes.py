@@ -1,11 +1,11 @@
 """Seeded, scored episodes: one at a time on a single env, or many at once on the batched env.
 
 Both runners return the same :class:`EpisodeRecord` for the same seed: the batched env steps
-each sub-env bit for bit as ``gym.make(id)`` does (tests/test_batched.py), so a policy that
-acts on each observation row alone (the expert, the comparison controllers, SB3 models up to
+each sub-env bit for bit as ``gym.make(id)`` does (tests/sgc_env/envs/test_batch.py), so a policy
+that acts on each observation row alone (the expert, the comparison controllers, SB3 models up to
 the float rounding of a batched matrix product) gives the same episodes either way
-(tests/test_episodes.py). What the batched runner saves is the per-env Python and PyBullet
-overhead: ``sgc evaluate --num-envs``.
+(tests/baselines/evaluation/test_episodes.py). What the batched runner saves is the per-env Python
+and PyBullet overhead: ``sgc evaluate --num-envs``.
 """
 
 from __future__ import annotations

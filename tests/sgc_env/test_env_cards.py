@@ -9,7 +9,7 @@ import gymnasium as gym
 import sgc_env
 from sgc_env.env_cards import CARDS, card_markdown, cards_markdown, gif_path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards", "Starting State",
             "Episode End", "Arguments", "Version History")  # fmt: skip
 

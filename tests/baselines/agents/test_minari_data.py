@@ -23,7 +23,7 @@ def datasets(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 def test_record_load_replay_matches(datasets: Path) -> None:
     publisher = {"author": "sgc tests", "author_email": "tests@sgc.invalid",
-                 "code_permalink": "tests/test_minari.py"}  # fmt: skip
+                 "code_permalink": "tests/baselines/agents/test_minari_data.py"}  # fmt: skip
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no out-of-space actions, no Minari advice left
         record_minari("SGCRod-v0", 2, 7, "sgc/rod/expert-v0", **publisher)

@@ -7,7 +7,7 @@ from pathlib import Path
 import sgc_env
 from sgc_env import ladder
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_every_registered_id_is_on_the_ladder_once():

@@ -9,7 +9,7 @@ from baselines.cli.main import main
 from baselines.zoo.cards import card_markdown, recipe
 from baselines.zoo.manifest import CHECKPOINTS, load_manifest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 SECTIONS = ("**Env**", "**Algorithm**", "**Recipe**", "**Training seed**",
             "**Training steps**", "**Wall clock**", "## Held-out results", "sgc evaluate --env",
             "## One episode")  # fmt: skip

@@ -20,7 +20,7 @@ from baselines.agents.train import TrainConfig, train  # noqa: E402
 from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures  # noqa: E402
 from sgc_env.envs.rewards import TRACK_COST_CAP, schedule_cost, tracks_of  # noqa: E402
 
-BENCHMARK_HP = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams"
+BENCHMARK_HP = Path(__file__).resolve().parents[3] / "benchmarks" / "hyperparams"
 
 
 def _features(extractor: ScheduleFeatures, obs: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ pytest.importorskip("stable_baselines3")
 import sgc_env  # noqa: E402, F401
 from baselines.cli import main as cli  # noqa: E402
 
-SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
+SHIPPED = Path(__file__).resolve().parents[3] / "baselines" / "checkpoints"
 
 
 class Payload:

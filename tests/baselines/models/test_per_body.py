@@ -29,7 +29,7 @@ from baselines.models.per_body import (  # noqa: E402
 )
 from sgc_env.observation import BODY_BLOCK_SIZE  # noqa: E402
 
-RECIPE = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams" / "ppo_threerod"
+RECIPE = Path(__file__).resolve().parents[3] / "benchmarks" / "hyperparams" / "ppo_threerod"
 RANDOM_ID = next(i for i in sgc_env.ENV_IDS if i.startswith("SGCThreeRodsRandom-"))
 PAPER_ID = "SGCThreeRods-v1"
 SHARED = ("mlp_extractor.", "action_net.linear.", "value_net.linear.", "log_std")

@@ -380,7 +380,7 @@ def test_train_command_runs(tmp_path: Path, tiny_hp: Path) -> None:
 
 # ---------------------------------------------------------------- shipped models and long runs
 
-CHECKPOINTS = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
+CHECKPOINTS = Path(__file__).resolve().parents[3] / "baselines" / "checkpoints"
 
 
 def test_shipped_checkpoints_are_small_and_score() -> None:

@@ -117,7 +117,7 @@ def _kink_rows(episodes: int, policy: str = "expert") -> list[dict]:
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "scripts" / "kink_table.py"
+    path = Path(__file__).resolve().parents[3] / "scripts" / "kink_table.py"
     spec = importlib.util.spec_from_file_location("kink_table", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
@@ -172,7 +172,7 @@ def test_expert_smooth_stays_within_the_force_and_torque_caps():
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "scripts" / "action_limits.py"
+    path = Path(__file__).resolve().parents[3] / "scripts" / "action_limits.py"
     spec = importlib.util.spec_from_file_location("action_limits", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

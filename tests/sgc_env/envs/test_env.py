@@ -494,7 +494,7 @@ def test_dense_reward_is_its_documented_formula():
 
 
 def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
-    from conftest import closing_every_env
+    from tests.conftest import closing_every_env
 
     with closing_every_env() as made:
         left_open = gym.make("SGCPoint-v0")

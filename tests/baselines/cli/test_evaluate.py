@@ -14,7 +14,7 @@ import pytest
 from baselines.cli import main as cli
 from baselines.evaluation.harness import GOAL_COLUMNS
 
-SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
+SHIPPED = Path(__file__).resolve().parents[3] / "baselines" / "checkpoints"
 
 
 @pytest.fixture(autouse=True)

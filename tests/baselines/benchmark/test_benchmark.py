@@ -289,7 +289,7 @@ def test_failed_runs_are_recorded_and_retried_on_request(
 # Real processes on the tiny grid (one worker), so that SIGKILL and two drivers racing for one
 # folder are what happens, not a simulation of it.
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def _process_argv(out: Path, hp: Path) -> list[str]:

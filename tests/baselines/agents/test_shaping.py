@@ -99,7 +99,7 @@ def test_alive_turns_the_failure_charge_into_a_per_step_bonus() -> None:
 
 
 def test_recipe_field_and_bad_values(tmp_path: Path) -> None:
-    folder = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams" / "ppo_rod_smooth"
+    folder = Path(__file__).resolve().parents[3] / "benchmarks" / "hyperparams" / "ppo_rod_smooth"
     assert load_hyperparams("ppo", "SGCRod-v0", folder).reward_shaping == "smooth"
     (tmp_path / "ppo.yml").write_text(
         "SGCRod-v0: {n_timesteps: 10, policy: MlpPolicy, reward_shaping: cubic}\n"

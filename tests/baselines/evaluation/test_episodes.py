@@ -23,7 +23,7 @@ def _as_json(value):
 def _infos(infos):
     """Infos without "TimeLimit.truncated": rl_zoo3's gym_patches (imported by other tests)
     make Gymnasium's TimeLimit add it on a single env's last step; the batched env has no
-    TimeLimit wrapper (as in tests/test_batched.py)."""
+    TimeLimit wrapper (as in tests/sgc_env/envs/test_batch.py)."""
     return [{k: v for k, v in info.items() if k != "TimeLimit.truncated"} for info in infos]
 
 

@@ -24,7 +24,7 @@ from baselines.benchmark.grid import (  # noqa: E402
 from baselines.benchmark.report import markdown, write_report  # noqa: E402
 from baselines.cli import main as cli  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 #: PPO small enough that one update takes milliseconds (the budget's overshoot is one update).
 TINY_PPO = {"n_timesteps": 128, "policy": "MlpPolicy", "n_envs": 2, "n_steps": 32,
             "batch_size": 64, "n_epochs": 1, "policy_kwargs": "dict(net_arch=[8])"}  # fmt: skip

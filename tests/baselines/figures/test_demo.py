@@ -21,7 +21,7 @@ from sgc_env.scenario.load import builtin_path
 from sgc_env.scenes import three_rods
 from sgc_env.simulator import pybullet
 
-ROD_MODEL = Path(__file__).resolve().parents[1] / "baselines/checkpoints/ppo_dagger_SGCRod-v0.zip"
+ROD_MODEL = Path(__file__).resolve().parents[3] / "baselines/checkpoints/ppo_dagger_SGCRod-v0.zip"
 """A shipped model of the one-rod env (6 actions): it does not fit the three rods (18)."""
 OUTPUTS = {
     "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png", "goals.csv",
