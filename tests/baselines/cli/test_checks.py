@@ -114,7 +114,7 @@ def test_interrupted_evaluate_keeps_the_earlier_results(tmp_path, monkeypatch, c
 
 
 def test_interrupted_demo_leaves_no_stub_video_beside_old_plates(tmp_path, monkeypatch):
-    import baselines.figures.demo as demo_module
+    import baselines.figures.demo_compare as demo_module
 
     out = tmp_path / "demo"
     out.mkdir()
@@ -141,7 +141,7 @@ def test_interrupted_train_keeps_the_earlier_run_and_the_new_checkpoints(tmp_pat
     (out / "final_model.zip").write_bytes(b"the earlier, whole model")
     (out / "config.json").write_text('{"earlier": true}')
 
-    def interrupted(cfg):
+    def interrupted(cfg, hp=None):
         (Path(cfg.out) / "checkpoints").mkdir()
         (Path(cfg.out) / "checkpoints" / "ppo_64_steps.zip").write_bytes(b"checkpoint")
         (Path(cfg.out) / "final_model.zip").write_bytes(b"half a model")
