@@ -13,7 +13,7 @@ OUT=${OUT:-runs/benchmark/budget}
 SEEDS=${SEEDS:-10}
 WORKERS=${WORKERS:-2}
 SGC=${SGC:-.venv/bin/sgc}
-# keep in step with the budget recipes of benchmarks/recipes.yml (tests/test_budget.py checks)
+# keep in step with the budget recipes of benchmarks/recipes.yml (tests/baselines/agents/test_budget.py checks)
 ROWS=ppo-rod300-300s,sac-300s,td3-300s,ppo-raw-300s,bc-dagger-300s
 ROWS=$ROWS,ppo-point500k-120s,ppo-raw-120s,sac-120s,td3-120s,her-time-120s,bc-dagger-120s
 if [[ " $* " != *" --report-only "* ]]; then

@@ -4,11 +4,12 @@ The prose of each card (description, starting state, version history) is data in
 :data:`CARDS`; spaces, the observation layout, limits, episode lengths and registered
 arguments are read from ``gym.make`` and the registry, so a card cannot drift from the env.
 ``python -m sgc_env.env_cards --write docs/envs`` writes one page per id there (and the
-folder's index); ``tests/test_env_cards.py`` checks that the pages are exactly what it writes.
+folder's index); ``tests/sgc_env/test_env_cards.py`` checks that the pages are exactly what it
+writes.
 
 **Versions.** Any change to observations, rewards or dynamics bumps the id's version, as
 Gymnasium does: add a :class:`Version` at the end of the card's ``versions`` (one line) and
-register the id under its new name; ``tests/test_env_cards.py`` checks that every registered
+register the id under its new name; ``tests/sgc_env/test_env_cards.py`` checks that every registered
 id carries its card's latest version.
 """
 

@@ -33,7 +33,7 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.agents.pushes import Pushes, apply_random_push, push_rng
-from baselines.atomic_files import write_atomic
+from baselines.common.atomic_files import write_atomic
 from sgc_env import check_env_id
 
 __all__ = ["FORMAT_VERSION", "Demonstrations", "load_demos", "record_demos"]

@@ -16,9 +16,9 @@ from typing import Any
 
 import yaml
 
-from baselines.agents.features import ACTIVATIONS
-from baselines.shipped import hyperparams_file
-from baselines.value_types import describe, matches
+from baselines.common.shipped import hyperparams_file
+from baselines.common.value_types import describe, matches
+from baselines.models.features import ACTIVATIONS
 
 __all__ = [
     "ALGORITHMS",
@@ -64,11 +64,11 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
     if short in ACTIVATIONS:
         return getattr(nn, short)
     if short == "StandardizeObservation":
-        from baselines.agents.features import StandardizeObservation
+        from baselines.models.features import StandardizeObservation
 
         return StandardizeObservation
     if short == "ScheduleFeatures":
-        from baselines.agents.schedule_features import ScheduleFeatures
+        from baselines.models.schedule_features import ScheduleFeatures
 
         return ScheduleFeatures
     if short == "HerReplayBuffer":
@@ -81,7 +81,7 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
 def _policy_class(name: str) -> str | type:
     """SB3's policy aliases stay strings; ``PerBodyPolicy`` is this project's class."""
     if name == "PerBodyPolicy":
-        from baselines.agents.per_body import PerBodyPolicy
+        from baselines.models.per_body import PerBodyPolicy
 
         return PerBodyPolicy
     return name

@@ -21,7 +21,7 @@ from typing import Any
 
 import yaml
 
-from baselines.value_types import describe, matches
+from baselines.common.value_types import describe, matches
 
 __all__ = [
     "EVAL_SEED",
@@ -292,7 +292,7 @@ def build_grid(
 ) -> list[RunSpec]:
     """Every (recipe, env, seed), after checking the arguments (``ValueError`` naming them)."""
     from baselines.agents.hyperparams import load_hyperparams
-    from baselines.env_kwargs import check_env_kwargs
+    from baselines.common.env_kwargs import check_env_kwargs
     from sgc_env import check_env_id
 
     if not recipes:

@@ -199,7 +199,8 @@ def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[
 
 
 def add_trust_argument(parser: argparse.ArgumentParser) -> None:
-    """``--trust-model``: load model files with SB3's unpickling (see baselines.model_files)."""
+    """``--trust-model``: load model files with SB3's unpickling (see
+    baselines.models.model_files)."""
     parser.add_argument(
         "--trust-model", action="store_true",
         help="unpickle model files (.zip fields, .vecnormalize.pkl) as SB3 does: a file can "
@@ -212,7 +213,7 @@ def trust_model(args: argparse.Namespace, command: str) -> bool:
     """``args.trust_model``, printing the risk to stderr when it is set."""
     trust = bool(getattr(args, "trust_model", False))
     if trust:
-        from baselines.model_files import TRUST_WARNING
+        from baselines.models.model_files import TRUST_WARNING
 
         print(f"sgc {command}: warning: {TRUST_WARNING}", file=sys.stderr)
     return trust

@@ -4,8 +4,8 @@ Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) 
 :class:`~sgc_env.envs.world.WorldView` of a :class:`~sgc_env.envs.world.SharedWorld`; the
 scenes are spread over worlds of about :data:`SHARD_OBJECTS` objects (why: there). A control
 step gathers every stepping sub-env's drives, runs each world's substeps once, then observes
-every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters
-differ only in their reset conventions and in how they batch what this returns.
+every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.agents.sb3_vec_env``)
+adapters differ only in their reset conventions and in how they batch what this returns.
 
 A sub-env that does not step in a call (it is being reset) still has bodies in the world that
 the substeps integrate; its reset comes after the physics and overwrites their state, so it

@@ -4,8 +4,8 @@ Each function repeats one scalar helper (:mod:`sgc_env.paper.quaternion`, Python
 ``min``/``max``) on arrays of vectors (last axis xyz or xyzw), operation for operation in the
 scalar code's order: numpy evaluates ``a + b * c + d`` as Python does (no reordering, no fused
 multiply-add) and the components of a cross product come from one gather each, so every
-element equals the scalar result bit for bit (tests/test_batch_math.py). Rewrites used, all
-exact in IEEE arithmetic: ``-a * b == a * (-b)``, ``x - y == x + (-y)``, and a product times
+element equals the scalar result bit for bit (tests/sgc_env/envs/test_batch_math.py). Rewrites used,
+all exact in IEEE arithmetic: ``-a * b == a * (-b)``, ``x - y == x + (-y)``, and a product times
 -1 is its negation. ``atan2``, the one transcendental function, goes through ``math.atan2``
 per element: numpy's SIMD versions may differ from libm's in the last bit. Branches become
 ``np.where`` over both sides, skipped where every element takes the same one (callers silence

@@ -5,8 +5,8 @@ times the single env's per-body Python (``_observe``, ``GoalTask.measure``, the 
 ``Actuation.drives``, the info). :class:`BatchTask` holds every sub-env's state in
 (N, bodies, ...) arrays and repeats that work on them, operation for operation in the scalar
 code's order (:mod:`.batch_math`), so that each sub-env's observation, reward, flags, drives
-and info equal the single env's bit for bit (tests/test_batched.py compares them on every id
-and reward mode). It is a second implementation of the scalar task; what stays scalar is
+and info equal the single env's bit for bit (tests/sgc_env/envs/test_batch.py compares them on every
+id and reward mode). It is a second implementation of the scalar task; what stays scalar is
 what is rare: goal switching (``GoalTask.advance`` on goal ticks, its new goal copied into
 the arrays afterwards), resets, pushes and the props' moves.
 

@@ -3,7 +3,7 @@
 ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` builds N sub-envs
 in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags
 and goal events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
-(tests/test_batched.py). Conventions:
+(tests/sgc_env/envs/test_batch.py). Conventions:
 
 - ``single_observation_space`` / ``single_action_space``; batched spaces from Gymnasium;
 - next-step autoreset (``metadata["autoreset_mode"]``): the step after a sub-env ends resets

@@ -73,8 +73,8 @@ def _save_npz(path: Path, traj: dict[str, Any], goals: list[list[Any]]) -> None:
 
 def run(args: argparse.Namespace) -> int:
 
-    from baselines.cli import plots
-    from baselines.evaluation import run_episode, write_summary_json
+    from baselines.evaluation.harness import run_episode, write_summary_json
+    from baselines.figures import plots
     from baselines.policies import make_policy, policy_label
 
     console = make_console()
