@@ -70,14 +70,14 @@ def test_help_shows_defaults(capsys) -> None:
 _DEMO_TABLE = """
 import sys
 from types import SimpleNamespace
-from baselines.cli.commands.demo import scorecard_table
+from baselines.cli.console import demo_scorecard_table
 from baselines.cli.console import make_console
 rod = dict(rod="rod_gold", goals=25, goals_met=25, position_error_max_m=2.0e-15,
            orientation_error_max_rad=3.7e-15, closest_approach_offset_max_s=1.8e-15,
            sparc_track=-2.21, goal_speed_ratio_min=0.68, acceleration_kink=15.1,
            angular_acceleration_kink=29.2)
 result = SimpleNamespace(label="expert", per_rod=[rod] * 3)
-make_console().print(scorecard_table(SimpleNamespace(policy="expert", end_rule="tangent"), result))
+make_console().print(demo_scorecard_table(SimpleNamespace(policy="expert", end_rule="tangent"), result))
 """
 
 
