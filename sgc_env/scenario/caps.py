@@ -1,0 +1,101 @@
+"""The one table of caps on the work a file from elsewhere can ask for.
+
+A scenario, a recipe, a hyperparameter file, a model zip, its statistics, a benchmark result
+or a demonstrations file is small on disk, but a count inside it (bodies, goals after a path
+expands, waypoints, network widths, simulation substeps, array rows) multiplies the work of
+loading or running it. Each count is checked against :data:`CAPS` before that work starts,
+and a file over a cap gets one line naming the file, the field and the cap. The table lives
+at the bottom layer so that the scenario parser and the model, demonstration and benchmark
+loaders above it read the same numbers; docs/untrusted-files.md shows it with the reasons,
+and the tests try each cap just under and just over.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+__all__ = ["CAPS", "Cap", "cap"]
+
+MIB = 1 << 20
+
+
+class Cap(NamedTuple):
+    """The largest value a file may ask for, what it counts and why it is where it is."""
+
+    limit: int
+    unit: str
+    counts: str
+    reason: str
+
+
+CAPS: dict[str, Cap] = {
+    "file_bytes": Cap(
+        8 * MIB, "bytes",
+        "a text file read whole: scenario, recipes, hyperparameters, VecNormalize statistics, "
+        "a model's `data` member and `config.json`, a benchmark's `result.json`/`failed.json`",
+        "parsing costs 10-100 times the text in memory; the largest shipped file is 12 KB"),
+    "nesting": Cap(
+        64, "levels", "nesting of lists and mappings in a YAML or JSON document",
+        "the parsers and every walk over the data recurse once per level (Python stops at "
+        "1000); the deepest shipped file has 6"),
+    "data_nodes": Cap(
+        1_000_000, "values", "values in a YAML or JSON document, an alias counted at each use",
+        "a YAML alias repeats a subtree without repeating its text: a 1 KB file can stand for "
+        "billions of values"),
+    "bodies": Cap(
+        32, "bodies", "bodies of a scenario",
+        "each body is planned and checked when the scenario loads (~0.1 s) and simulated "
+        "every substep; the largest shipped scene has 3"),
+    "props": Cap(
+        32, "props", "props (moving obstacles, targets) of a scenario",
+        "each prop's path is sampled at every substep of the episode"),
+    "goals": Cap(
+        10_000, "goals", "goals of a scenario, counted after every path goal expands",
+        "each goal is routed, planned and observed; 10,000 load in ~3 s"),
+    "path_samples": Cap(
+        1_000, "samples", "samples of one point-to-path goal",
+        "each sample is a goal of its own and needs at least one control tick"),
+    "helix_turns": Cap(
+        1_000, "turns", "turns of a helix path",
+        "a curve is sampled 64 times per sample interval; more turns than samples is aliasing"),
+    "polyline_points": Cap(
+        1_000, "points", "waypoints of a polyline path",
+        "the curve is interpolated through every point at each of 65 x samples evaluations"),
+    "prop_waypoints": Cap(
+        10_000, "waypoints", "waypoints of one prop",
+        "a prop's position is interpolated through them at every substep"),
+    "sim_frequency": Cap(
+        10_000, "Hz", "`sim_frequency` from `--env-kwargs`, a recipe or a demonstrations file",
+        "every control tick runs sim_frequency / control_frequency PyBullet steps; 10 kHz is "
+        "40 times the default 240 Hz"),
+    "model_file_bytes": Cap(
+        256 * MIB, "bytes", "a model zip on disk (it is read whole, once)",
+        "the shipped models are under 1 MB; a 4096-wide net with its optimizer is ~200 MB"),
+    "zip_members": Cap(
+        64, "members", "members of a model zip",
+        "SB3 writes six; each member is read once to check it"),
+    "zip_member_bytes": Cap(
+        128 * MIB, "bytes", "a model zip member's uncompressed size (as declared, and as read)",
+        "a 9 MB zip can hold an 8 GiB member that decompresses into memory"),
+    "net_width": Cap(
+        4096, "units", "width of a layer in `net_arch` and of a features extractor",
+        "weights grow with the square of the width: [8000]*4 took 2.6 GB and a minute"),
+    "net_layers": Cap(
+        16, "layers", "hidden layers in `net_arch` (per head)",
+        "every layer is built and run at each step; the shipped nets have 2-3"),
+    "net_parameters": Cap(
+        16_000_000, "weights", "weights of the hidden layers `net_arch` asks for",
+        "64 MB of float32 weights, 256 MB with Adam's moments and gradients"),
+    "demo_rows": Cap(
+        2_000_000, "rows", "steps (rows) of a demonstrations npz",
+        "behaviour cloning runs epochs over every row; `sgc demos` writes ~300 per episode"),
+    "npz_array_bytes": Cap(
+        512 * MIB, "bytes", "one array of a demonstrations npz, from its header's shape",
+        "a header can claim 10^12 rows in a few bytes; the array is allocated before read"),
+}  # fmt: skip
+"""Cap name -> :class:`Cap`. A value equal to the limit is allowed, one above is refused."""
+
+
+def cap(name: str) -> int:
+    """The limit of cap ``name``."""
+    return CAPS[name].limit
