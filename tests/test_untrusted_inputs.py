@@ -33,7 +33,7 @@ HYPERPARAMS = {
     "  n_timesteps: 1e400\n": "must be finite numbers",
     "  policy_kwargs: 'dict(activation_fn=os.system)'\n": "name 'os.system' is not allowed",
     "  policy_kwargs: \"__import__('os').system('x')\"\n": "unsupported expression",
-    "  policy_kwargs: {net_arch: x}\n": "hyperparameters of ppo for SGCPoint-v0",
+    "  policy_kwargs: {net_arch: x}\n": "policy_kwargs.net_arch: expected a list of layer",
     "  normalize: 'dict(clip_obs=\"x\")'\n": "normalize: clip_obs must be a finite number",
     "  normalize: {norm_obs: 1}\n": "normalize: norm_obs must be true/false",
     "  policy: [MlpPolicy]\n": "policy must be a name",
@@ -81,7 +81,7 @@ RECIPES = {
     "{algo: ppo, env_kwargs: {foo: 1}}": "env_kwargs: SGCPoint-v0 does not take {'foo': 1}",
     "{algo: [ppo]}": "algo must be one of",
     "[1, 2]": "expected a mapping, got list",
-    "{algo: ppo}\n\t- tab": "bad YAML: while scanning",
+    "{algo: ppo}\n\t- tab": "not valid YAML: while scanning",
 }
 
 

@@ -19,9 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from baselines.value_types import describe, matches
+from sgc_env.scenario.bounded import escaped, load_yaml, read_text
 
 __all__ = [
     "EVAL_SEED",
@@ -239,11 +238,9 @@ def load_recipes(path: str | Path) -> list[Recipe]:
     """
     file = Path(path)
     if not file.is_file():
-        raise ValueError(f"--recipes: no file {str(path)!r}")
-    try:
-        data = yaml.safe_load(file.read_text())
-    except yaml.YAMLError as exc:
-        raise ValueError(f"--recipes: {file}: bad YAML: {' '.join(str(exc).split())}") from None
+        raise ValueError(f"--recipes: no file {escaped(repr(str(path)))}")
+    where = f"--recipes: {escaped(file)}"
+    data = load_yaml(read_text(file, "--recipes:"), where)
     entries = data.get("recipes") if isinstance(data, Mapping) else None
     if not isinstance(entries, list) or not entries:
         raise ValueError(f"--recipes: {file}: expected a non-empty list under 'recipes:'")

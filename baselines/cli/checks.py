@@ -24,6 +24,7 @@ from typing import Any
 __all__ = [
     "UsageError",
     "add_trust_argument",
+    "error_exit",
     "bounded_int",
     "env_kwargs",
     "existing_dir",
@@ -43,6 +44,16 @@ __all__ = [
 
 class UsageError(ValueError):
     """A command-line argument is wrong; ``sgc`` prints the message and exits 2."""
+
+
+def error_exit(command: str, exc: BaseException | str) -> int:
+    """Print ``sgc COMMAND: error: MESSAGE`` on one line of stderr and return 2. The message
+    is escaped: text it quotes from a file (a newline, a terminal escape) cannot start a line
+    of its own or forge one."""
+    from sgc_env.scenario.bounded import escaped
+
+    print(f"sgc {command}: error: {escaped(exc, 2000)}", file=sys.stderr)
+    return 2
 
 
 def _number(kind: Callable[[str], Any], text: str) -> Any:
@@ -171,11 +182,26 @@ def env_kwargs(text: str) -> dict[str, Any]:
     return value
 
 
+def _real_folder(out: Path, relative: Path) -> Path:
+    """``out / relative`` as a real folder: a link met on the way (to a folder elsewhere,
+    or dangling) is replaced by a folder, never written through."""
+    folder = out
+    for part in relative.parts:
+        folder = folder / part
+        if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+            folder.unlink()
+        folder.mkdir(exist_ok=True)
+    return folder
+
+
 def _move_files(stage: Path, out: Path, folder: str = "") -> None:
+    """Move the staged files into ``out``; ``os.replace`` puts each file in place of a file
+    or a link of its name (it never writes through a link), and :func:`_real_folder` does
+    the same for the folders on the way."""
+    out.mkdir(parents=True, exist_ok=True)
     for src in sorted(p for p in (stage / folder).rglob("*") if p.is_file()):
-        dest = out / src.relative_to(stage)
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(src, dest)
+        relative = src.relative_to(stage)
+        os.replace(src, _real_folder(out, relative.parent) / relative.name)
 
 
 @contextlib.contextmanager

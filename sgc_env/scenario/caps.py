@@ -68,6 +68,9 @@ CAPS: dict[str, Cap] = {
         10_000, "Hz", "`sim_frequency` from `--env-kwargs`, a recipe or a demonstrations file",
         "every control tick runs sim_frequency / control_frequency PyBullet steps; 10 kHz is "
         "40 times the default 240 Hz"),
+    "n_envs": Cap(
+        256, "envs", "`n_envs` of a hyperparameter file",
+        "each env is a PyBullet world of its own (tens of MB); the shipped files use 1-8"),
     "model_file_bytes": Cap(
         256 * MIB, "bytes", "a model zip on disk (it is read whole, once)",
         "the shipped models are under 1 MB; a 4096-wide net with its optimizer is ~200 MB"),

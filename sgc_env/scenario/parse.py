@@ -153,7 +153,7 @@ def _goal_count(raw: Any) -> int:
         return 0
     count = 0
     for g in raw:
-        samples = g.get("samples") if isinstance(g, Mapping) and "path" in g else 1
+        samples: Any = g.get("samples") if isinstance(g, Mapping) and "path" in g else 1
         ok = isinstance(samples, int) and not isinstance(samples, bool)
         count += samples if ok and 1 <= samples <= MAX_PATH_SAMPLES else 1
     return count

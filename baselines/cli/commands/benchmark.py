@@ -12,13 +12,11 @@ benchmarks on one ``--out`` share the work: each run is claimed by one of them
 from __future__ import annotations
 
 import argparse
-import json
 import shlex
-import sys
 from pathlib import Path
 from typing import Any
 
-from baselines.cli.checks import env_kwargs
+from baselines.cli.checks import env_kwargs, error_exit, out_dir
 
 __all__ = ["add_arguments", "run"]
 
@@ -71,7 +69,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="episodes per learning-curve point (they pick the best model)",
     )
     parser.add_argument("--eval-seed", type=int, default=10_000, help="first learning-curve seed")
-    parser.add_argument("--out", type=Path, default=Path("runs/benchmark"))
+    parser.add_argument("--out", type=out_dir, default=Path("runs/benchmark"),
+                        help="folder of the runs and the leaderboard")  # fmt: skip
     parser.add_argument("--backend", choices=("local", "ray"), default="local")
     parser.add_argument(
         "--workers",
@@ -118,10 +117,6 @@ def _grid(args: argparse.Namespace) -> list[Any]:
         curve_episodes=args.curve_episodes, eval_episodes=args.eval_episodes,
         eval_seed=args.eval_seed, test_seed=args.test_seed,
     )  # fmt: skip
-
-
-def _read(path: Path) -> dict[str, Any]:
-    return json.loads(path.read_text())
 
 
 def _run_grid(todo: list[Any], backend: Any, root: Path, console: Any) -> list[str]:
@@ -194,14 +189,14 @@ def run(args: argparse.Namespace) -> int:
     from baselines.benchmark.backends import make_backend
     from baselines.benchmark.execute import FAILED_FILE, RESULT_FILE
     from baselines.benchmark.report import write_report
+    from baselines.benchmark.results import read_record
 
     console = Console()
     try:
         grid = _grid(args)
         backend = make_backend(args.backend, args.workers, args.address, args.cpus_per_run)
     except ValueError as exc:
-        print(f"sgc benchmark: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("benchmark", exc)
     root = args.out
     finished = [s for s in grid if (s.folder(root) / RESULT_FILE).is_file()]
     failed_before = [s for s in grid if s not in finished
@@ -217,10 +212,13 @@ def run(args: argparse.Namespace) -> int:
     if elsewhere:
         print(f"{len(elsewhere)} run(s) left to another sgc benchmark on {root} (running or "
               f"finished there): {', '.join(elsewhere)}", flush=True)  # fmt: skip
-    results = [_read(s.folder(root) / RESULT_FILE) for s in grid
-               if (s.folder(root) / RESULT_FILE).is_file()]  # fmt: skip
-    failed = [_read(s.folder(root) / FAILED_FILE) for s in grid
-              if (s.folder(root) / FAILED_FILE).is_file()]  # fmt: skip
+    try:
+        results = [read_record(s.folder(root) / RESULT_FILE, s, finished=True) for s in grid
+                   if (s.folder(root) / RESULT_FILE).is_file()]  # fmt: skip
+        failed = [read_record(s.folder(root) / FAILED_FILE, s, finished=False) for s in grid
+                  if (s.folder(root) / FAILED_FILE).is_file()]  # fmt: skip
+    except ValueError as exc:
+        return error_exit("benchmark", exc)
     meta = {
         "command": shlex.join(
             ["sgc", *(w for w in getattr(args, "argv", ["benchmark"]) if w != "--report-only")]

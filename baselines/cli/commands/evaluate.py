@@ -11,13 +11,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import (
     add_trust_argument,
+    error_exit,
     known_env_id,
     nonneg_float,
     nonneg_int,
@@ -276,8 +276,7 @@ def run(args: argparse.Namespace) -> int:
         for env_id in envs:
             known_env_id(env_id)
     except ValueError as exc:
-        print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("evaluate", exc)
     single = len(policies) == 1 and len(envs) == 1
     if single:
         root = args.out or Path("runs/evaluate") / envs[0] / labels[0]
@@ -297,8 +296,7 @@ def run(args: argparse.Namespace) -> int:
                         env_kwargs=None if args.reward is None else {"reward": args.reward},
                     )  # fmt: skip
                 except ValueError as exc:
-                    print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-                    return 2
+                    return error_exit("evaluate", exc)
                 _write_pair(result, stage / folder, not args.no_plots)
                 summaries.append(result.summary)
                 if single:
