@@ -33,7 +33,8 @@ CAPS: dict[str, Cap] = {
         8 * MIB, "bytes",
         "a text file read whole: scenario, recipes, hyperparameters, VecNormalize statistics, "
         "a model's `data` member and `config.json`, a benchmark's `result.json`/`failed.json`",
-        "parsing costs 10-100 times the text in memory; the largest shipped file is 12 KB"),
+        "parsing costs 10-100 times the text in memory; the largest shipped text file is 15 KB, "
+        "the largest model `data` member 185 KB"),
     "nesting": Cap(
         64, "levels", "nesting of lists and mappings in a YAML or JSON document",
         "the parsers and every walk over the data recurse once per level (Python stops at "
@@ -70,7 +71,8 @@ CAPS: dict[str, Cap] = {
         "40 times the default 240 Hz"),
     "n_envs": Cap(
         256, "envs", "`n_envs` of a hyperparameter file",
-        "each env is a PyBullet world of its own (tens of MB); the shipped files use 1-8"),
+        "each env is a PyBullet world or a batched slot of its own; the shipped recipes use up "
+        "to 64"),
     "model_file_bytes": Cap(
         256 * MIB, "bytes", "a model zip on disk (it is read whole, once)",
         "the shipped models are under 1 MB; a 4096-wide net with its optimizer is ~200 MB"),
