@@ -44,6 +44,13 @@ def _path_goal(path: dict[str, Any], samples: int = 10, time: float = 5.0) -> di
 
 
 def _file_bytes(n: int, tmp: Path) -> None:
+    path = tmp / "big.json"
+    path.write_text('{"pad": "' + "x" * (n - 11) + '"}')
+    assert path.stat().st_size == n
+    load_json(read_bounded(path, "json"), str(path))
+
+
+def _yaml_bytes(n: int, tmp: Path) -> None:
     head = "name: caps\nbodies: [{name: b, shape: sphere, size: [0.05], position: [0, 0, 1], " \
            "goals: [{nail: [0, 0.5, 1], time: 1.0}]}]\n#"  # fmt: skip
     path = tmp / "big.yaml"
@@ -192,8 +199,9 @@ def _demos(tmp: Path, rows: int) -> Path:
     obs = np.zeros((rows, 1), np.float32)
     np.savez(path, observations=obs, actions=obs, rewards=obs[:, 0],
              terminations=np.zeros(rows, bool), truncations=np.zeros(rows, bool),
-             episode_starts=np.ones(rows, bool), seeds=np.arange(1), env_id=np.array("SGCPoint-v0"),
-             env_kwargs=np.array("{}"), pushes=np.array("{}"), format_version=np.array(1))  # fmt: skip
+             episode_starts=np.ones(rows, bool), seeds=np.arange(1),
+             env_id=np.array("SGCPoint-v0"), env_kwargs=np.array("{}"), pushes=np.array("{}"),
+             format_version=np.array(1))  # fmt: skip
     return path
 
 
@@ -220,7 +228,8 @@ def _npz_array_bytes(n: int, tmp: Path) -> None:
 
 
 PROBES: dict[str, Callable[[int, Path], None]] = {
-    "file_bytes": _file_bytes, "nesting": _nesting, "data_nodes": _data_nodes,
+    "file_bytes": _file_bytes, "yaml_bytes": _yaml_bytes, "nesting": _nesting,
+    "data_nodes": _data_nodes,
     "bodies": _bodies, "props": _props, "goals": _goals, "path_samples": _path_samples,
     "helix_turns": _helix_turns, "polyline_points": _polyline_points,
     "prop_waypoints": _prop_waypoints, "sim_frequency": _sim_frequency, "n_envs": _n_envs,

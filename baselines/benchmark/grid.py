@@ -191,6 +191,7 @@ def _check_name(name: Any, where: str) -> str:
 def _recipe(entry: Any, where: str) -> Recipe:
     from baselines.agents.budget import check_time_budget
     from baselines.agents.train import ALGORITHMS
+    from baselines.env_kwargs import check_kwarg_values
 
     if not isinstance(entry, Mapping):
         raise ValueError(f"{where}: expected a mapping, got {type(entry).__name__}")
@@ -209,6 +210,7 @@ def _recipe(entry: Any, where: str) -> Recipe:
     train = entry.get("train") or {}
     if not isinstance(env_kwargs, Mapping) or not isinstance(train, Mapping):
         raise ValueError(f"{where}: env_kwargs and train must be mappings")
+    check_kwarg_values(env_kwargs, f"{where}: env_kwargs")
     allowed = set(_train_fields()) - _OWNED
     bad = set(train) - allowed
     if bad:

@@ -185,6 +185,7 @@ def env_kwargs(text: str) -> dict[str, Any]:
 def _real_folder(out: Path, relative: Path) -> Path:
     """``out / relative`` as a real folder: a link met on the way (to a folder elsewhere,
     or dangling) is replaced by a folder, never written through."""
+    out.mkdir(parents=True, exist_ok=True)
     folder = out
     for part in relative.parts:
         folder = folder / part
@@ -198,7 +199,6 @@ def _move_files(stage: Path, out: Path, folder: str = "") -> None:
     """Move the staged files into ``out``; ``os.replace`` puts each file in place of a file
     or a link of its name (it never writes through a link), and :func:`_real_folder` does
     the same for the folders on the way."""
-    out.mkdir(parents=True, exist_ok=True)
     for src in sorted(p for p in (stage / folder).rglob("*") if p.is_file()):
         relative = src.relative_to(stage)
         os.replace(src, _real_folder(out, relative.parent) / relative.name)

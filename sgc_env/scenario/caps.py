@@ -35,14 +35,19 @@ CAPS: dict[str, Cap] = {
         "a model's `data` member and `config.json`, a benchmark's `result.json`/`failed.json`",
         "parsing costs 10-100 times the text in memory; the largest shipped text file is 15 KB, "
         "the largest model `data` member 185 KB"),
+    "yaml_bytes": Cap(
+        1 * MIB, "bytes", "the text of a YAML file: scenario, recipes, hyperparameters",
+        "reading YAML builds Python objects for every value as it goes (~15 us each, 1.6 MB "
+        "took 15 s); a scenario at the waypoint or goal cap is ~0.5 MB"),
     "nesting": Cap(
         64, "levels", "nesting of lists and mappings in a YAML or JSON document",
         "the parsers and every walk over the data recurse once per level (Python stops at "
         "1000); the deepest shipped file has 6"),
     "data_nodes": Cap(
-        1_000_000, "values", "values in a YAML or JSON document, an alias counted at each use",
-        "a YAML alias repeats a subtree without repeating its text: a 1 KB file can stand for "
-        "billions of values"),
+        250_000, "values", "values in a YAML or JSON document, an alias counted at each use",
+        "a YAML alias repeats a subtree without repeating its text (1 KB can stand for "
+        "billions of values), and building each value costs ~10 us: 250,000 take ~3 s; "
+        "a scenario at every other cap has ~100,000"),
     "bodies": Cap(
         32, "bodies", "bodies of a scenario",
         "each body is planned and checked when the scenario loads (~0.1 s) and simulated "
