@@ -325,6 +325,12 @@ def test_shipped_models_and_statistics_load() -> None:
             env.close()
 
 
+def test_the_docs_show_the_table_as_it_is() -> None:
+    from sgc_env.scenario.caps import caps_markdown
+
+    assert caps_markdown() in (ROOT / "docs" / "untrusted-files.md").read_text()
+
+
 def test_a_cap_message_names_the_file(tmp_path: Path) -> None:
     path = tmp_path / "huge.json"
     path.write_bytes(b" " * (cap("file_bytes") + 1))

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["CAPS", "Cap", "cap"]
+__all__ = ["CAPS", "Cap", "cap", "caps_markdown"]
 
 MIB = 1 << 20
 
@@ -109,3 +109,12 @@ CAPS: dict[str, Cap] = {
 def cap(name: str) -> int:
     """The limit of cap ``name``."""
     return CAPS[name].limit
+
+
+def caps_markdown() -> str:
+    """The table of docs/untrusted-files.md, written from :data:`CAPS`."""
+    rows = ["| cap | limit | counts | why |", "|---|---|---|---|"]
+    rows += [f"| `{name}` | {c.limit:,} {c.unit} | {c.counts} | {c.reason} |"
+             for name, c in CAPS.items()]  # fmt: skip
+    return "\n".join(rows) + "\n"
+
