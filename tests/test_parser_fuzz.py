@@ -40,6 +40,19 @@ TOKENS = ["[", "]", "{", "}", ",", ":", '"', "'", "&a", "*a", "!!python/name:os.
 TEXT = st.lists(st.sampled_from(TOKENS) | st.text(max_size=5), max_size=30).map("".join)
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _imported() -> None:
+    """The parsers' modules imported once, outside the deadline of the first draw."""
+    import importlib.util
+
+    if importlib.util.find_spec("stable_baselines3") is None:
+        return
+    for module in ("baselines.agents.hyperparams", "baselines.benchmark.grid",
+                   "baselines.benchmark.results", "baselines.normalization",
+                   "baselines.model_files", "baselines.agents.demos"):  # fmt: skip
+        importlib.import_module(module)
+
+
 def _mutate(blob: bytes, edits: list[tuple[int, int]]) -> bytes:
     data = bytearray(blob)
     for at, value in edits:
@@ -99,36 +112,36 @@ def test_policy_kwargs_strings(text: str) -> None:
         assert str(exc).startswith("policy_kwargs: ")
 
 
-HP = "SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_envs: 2\n  gamma: 0.9\n"
-
-
-@FUZZ
-@given(at=st.integers(0, len(HP)), insert=TEXT)
-def test_hyperparameter_files(at: int, insert: str, tmp_path: Path) -> None:
-    pytest.importorskip("stable_baselines3")
+def _hyperparams(folder: Path) -> Any:
     from baselines.agents.hyperparams import load_hyperparams
 
-    (tmp_path / "ppo.yml").write_text(HP[:at] + insert + HP[at:])
-    try:
-        load_hyperparams("ppo", "SGCPoint-v0", tmp_path)
-    except ValueError as exc:
-        assert "\n" not in str(exc)
+    return load_hyperparams("ppo", "SGCPoint-v0", folder)
 
 
-RECIPES = "recipes:\n  - {name: a, algo: ppo, timesteps: 64}\n"
+def _recipes(folder: Path) -> Any:
+    from baselines.benchmark.grid import load_recipes
+
+    return load_recipes(folder / "ppo.yml")
+
+
+#: An rl-zoo3 YAML reader -> the file it reads (``ppo.yml`` in a folder) as a valid text.
+YAML_FILES = {
+    _hyperparams: "SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_envs: 2\n",
+    _recipes: "recipes:\n  - {name: a, algo: ppo, timesteps: 64}\n",
+}
 
 
 @FUZZ
-@given(at=st.integers(0, len(RECIPES)), insert=TEXT)
-def test_recipe_files(at: int, insert: str, tmp_path: Path) -> None:
+@given(reader=st.sampled_from(list(YAML_FILES)), at=st.integers(0, 60), insert=TEXT)
+def test_hyperparameter_and_recipe_files(reader: Any, at: int, insert: str,
+                                         tmp_path: Path) -> None:  # fmt: skip
     pytest.importorskip("stable_baselines3")
-    from baselines.benchmark.grid import load_recipes
-
-    (tmp_path / "r.yml").write_text(RECIPES[:at] + insert + RECIPES[at:])
+    text = YAML_FILES[reader]
+    (tmp_path / "ppo.yml").write_text(text[:at] + insert + text[at:])
     try:
-        load_recipes(tmp_path / "r.yml")
+        reader(tmp_path)
     except ValueError as exc:
-        assert "r.yml" in str(exc) or str(exc).startswith("--recipes"), exc
+        assert "\n" not in str(exc) and "ppo.yml" in str(exc), exc
 
 
 @pytest.fixture(scope="module")

@@ -12,6 +12,7 @@ every parser failure, ``RecursionError`` and ``MemoryError`` included, becomes o
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -90,52 +91,46 @@ def read_text(path: str | Path, what: str) -> str:
                              f"{exc.reason}); save it as UTF-8") from None  # fmt: skip
 
 
-def check_tree(data: Any, where: str) -> Any:
-    """``data`` once its nesting and its number of values are within the caps; the walk is
-    iterative and stops at the first cap, so a self-referencing or alias-multiplied document
-    costs at most ``data_nodes`` steps."""
+def _walk(root: Any, children: Callable[[Any], Iterable[Any] | None], where: str) -> None:
+    """Visit ``root`` and its descendants (``children``: None for a leaf) within the nesting
+    and value caps; iterative, stopping at the first cap, so a self-referencing or
+    alias-multiplied document costs at most ``data_nodes`` steps."""
     depth_cap, node_cap = cap("nesting"), cap("data_nodes")
-    stack: list[tuple[Any, int]] = [(data, 1)]
+    stack: list[tuple[Any, int]] = [(root, 1)]
     nodes = 0
     while stack:
         node, depth = stack.pop()
         nodes += 1
         if nodes > node_cap:
             check_count(nodes, "data_nodes", where)
-        if isinstance(node, dict | list | tuple):
+        below = children(node)
+        if below is not None:
             if depth > depth_cap:
                 check_count(depth, "nesting", where)
-            items = node.items() if isinstance(node, dict) else enumerate(node)
-            for key, value in items:
-                stack.append((value, depth + 1))
-                if isinstance(node, dict):
-                    stack.append((key, depth + 1))
+            stack.extend((child, depth + 1) for child in below)
+
+
+def _data_children(node: Any) -> Iterable[Any] | None:
+    if isinstance(node, dict):
+        return [x for pair in node.items() for x in pair]
+    return node if isinstance(node, list | tuple) else None
+
+
+def _yaml_children(node: yaml.Node) -> Iterable[yaml.Node] | None:
+    if not isinstance(node, yaml.SequenceNode | yaml.MappingNode):
+        return None
+    return [x for item in node.value for x in (item if isinstance(item, tuple) else (item,))]
+
+
+def check_tree(data: Any, where: str) -> Any:
+    """``data`` once its nesting and its number of values are within the caps."""
+    _walk(data, _data_children, where)
     return data
 
 
 SAFE_LOADER: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 """PyYAML's safe loader, libyaml's where installed: its scanner and composer are C (the pure
 Python scanner takes minutes on 100k nested brackets) and it stops at 1000 flow levels."""
-
-
-def _check_nodes(root: yaml.Node, where: str) -> None:
-    """The composed YAML graph within the nesting and value caps, before any Python object is
-    constructed (construction is the slow, memory-hungry step: ~20 us a value). An alias
-    counts at each use, and a cycle stops at a cap."""
-    depth_cap, node_cap = cap("nesting"), cap("data_nodes")
-    stack: list[tuple[yaml.Node, int]] = [(root, 1)]
-    nodes = 0
-    while stack:
-        node, depth = stack.pop()
-        nodes += 1
-        if nodes > node_cap:
-            check_count(nodes, "data_nodes", where)
-        if isinstance(node, yaml.SequenceNode | yaml.MappingNode):
-            if depth > depth_cap:
-                check_count(depth, "nesting", where)
-            for item in node.value:
-                pairs = item if isinstance(item, tuple) else (item,)
-                stack.extend((child, depth + 1) for child in pairs)
 
 
 def load_yaml(text: str, where: str, loader: type = SAFE_LOADER) -> Any:
@@ -149,7 +144,7 @@ def load_yaml(text: str, where: str, loader: type = SAFE_LOADER) -> Any:
             node = reader.get_single_node()
             if node is None:
                 return None
-            _check_nodes(node, where)
+            _walk(node, _yaml_children, where)  # before construction, the slow step
             return reader.construct_document(node)
         finally:
             reader.dispose()
