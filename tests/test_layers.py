@@ -92,6 +92,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.vector", "baselines.observation_fields", "baselines.minimum_jerk",
      "baselines.tracking", "baselines.dynamic_constraints", "baselines.shipped"),
     ("baselines.atomic_files", "baselines.value_types", "baselines.env_kwargs",
+     "baselines.network_caps", "baselines.bounded_npz",
      "baselines.agents.features", "baselines.agents.schedule_features"),
     ("baselines.env_model",),
     ("baselines.agents.per_body",),

@@ -26,7 +26,7 @@ BASE = ("SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_steps: 64\n"
 
 #: hyperparameter file -> fragment of the error (each line replaces or extends BASE)
 HYPERPARAMS = {
-    "  learning_rate: [1, 2]\n": "learning_rate: expected a number or lin_<number>",
+    "  learning_rate: [1, 2]\n": "learning_rate: expected a finite number > 0 or lin_<number>",
     "  gamma: high\n": "gamma must be a finite number, got 'high'",
     "  batch_size: true\n": "batch_size must be an integer, got True",
     "  n_epochs: '2'\n": "n_epochs must be an integer, got '2'",

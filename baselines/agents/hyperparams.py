@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -148,12 +149,17 @@ def linear_schedule(initial: float):
 def _learning_rate(value: Any) -> Any:
     try:
         if isinstance(value, str) and value.startswith("lin_"):
-            return linear_schedule(float(value[4:]))
-        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
-            return float(value)
-    except ValueError:
+            rate = float(value[4:])
+            if math.isfinite(rate) and rate > 0:
+                return linear_schedule(rate)
+        elif isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            rate = float(value)
+            if math.isfinite(rate) and rate > 0:
+                return rate
+    except (ValueError, OverflowError):
         pass
-    raise ValueError(f"learning_rate: expected a number or lin_<number>, got {value!r}")
+    raise ValueError(f"learning_rate: expected a finite number > 0 or lin_<number>, got "
+                     f"{escaped(repr(value))}")  # fmt: skip
 
 
 _NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward")
