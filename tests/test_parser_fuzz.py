@@ -24,7 +24,7 @@ from hypothesis import strategies as st  # noqa: E402
 from sgc_env.scenario import ScenarioError, scenario_from_dict  # noqa: E402
 from sgc_env.scenario.bounded import FileLimitError, load_json, load_yaml  # noqa: E402
 
-FUZZ = settings(max_examples=30, deadline=timedelta(seconds=5), derandomize=True,
+FUZZ = settings(max_examples=40, deadline=timedelta(seconds=5), derandomize=True,
                 suppress_health_check=[HealthCheck.too_slow,
                                        HealthCheck.function_scoped_fixture])  # fmt: skip
 
@@ -66,19 +66,10 @@ EDITS = st.lists(st.tuples(st.integers(0, 1 << 20), st.integers(0, 255)), min_si
 
 
 @FUZZ
-@given(TEXT)
-def test_json_reader(text: str) -> None:
+@given(reader=st.sampled_from([load_json, load_yaml]), text=TEXT)
+def test_json_and_yaml_readers(reader: Any, text: str) -> None:
     try:
-        load_json(text, "fuzz")
-    except FileLimitError as exc:
-        assert str(exc).startswith("fuzz: ")
-
-
-@FUZZ
-@given(TEXT)
-def test_yaml_reader(text: str) -> None:
-    try:
-        load_yaml(text, "fuzz")
+        reader(text, "fuzz")
     except FileLimitError as exc:
         assert str(exc).startswith("fuzz: ")
 
