@@ -292,7 +292,7 @@ MODELS: dict[str, Case] = {
     "data nested 100k deep": Case(_model(lambda d: b"[" * 100_000 + b"]" * 100_000),
                                   "nested too deeply"),
     "data 5000-digit integer": Case(_model(lambda d: b'{"n": ' + b"9" * 5000 + b"}"),
-                                    "not JSON"),
+                                    "not valid JSON"),
     "net_arch [8000]*4": Case(_model(_net_arch), "net_arch[0]: 8000 units; at most 4096"),
     "140 KB Dict space text": Case(_model(_dict_space, env="SGCPointGoal-v0")),
     "8 GiB member claimed": Case(_huge_member, "'system_info.txt': 4026531840 bytes; at most"),
@@ -401,7 +401,7 @@ def _out_is_a_file(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
 
 
 RESULTS: dict[str, Case] = {
-    "result.json malformed": Case(_results("result.json", '{"spec": '), "not JSON"),
+    "result.json malformed": Case(_results("result.json", '{"spec": '), "not valid JSON"),
     "result.json a list": Case(_results("result.json", "[1, 2]"), "expected a JSON object"),
     "result.json keys missing": Case(_results("result.json", json.dumps({"spec": SPEC})),
                                      "timesteps must be a finite number"),

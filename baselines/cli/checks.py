@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import math
 import os
 import shutil
@@ -172,13 +171,15 @@ def known_env_id(env_id: str) -> str:
 
 
 def env_kwargs(text: str) -> dict[str, Any]:
-    """A JSON object (keyword arguments for ``gym.make``)."""
+    """A JSON object (keyword arguments for ``gym.make``), read within the caps."""
+    from sgc_env.scenario.bounded import FileLimitError, escaped, load_json
+
     try:
-        value = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise argparse.ArgumentTypeError(f"not valid JSON ({exc.msg} at {exc.pos})") from None
+        value = load_json(text, "JSON")
+    except FileLimitError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("JSON: ")) from None
     if not isinstance(value, dict):
-        raise argparse.ArgumentTypeError(f"expected a JSON object, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a JSON object, got {escaped(repr(text))}")
     return value
 
 

@@ -167,9 +167,9 @@ def load_json(text: str | bytes, where: str) -> Any:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise FileLimitError(f"{where}: not JSON ({exc.msg} at {exc.pos})") from None
+        raise FileLimitError(f"{where}: not valid JSON ({exc.msg} at {exc.pos})") from None
     except RecursionError:
         raise FileLimitError(f"{where}: nested too deeply to read") from None
     except _PARSE_FAILURES as exc:
-        raise FileLimitError(f"{where}: not JSON ({escaped(exc)})") from None
+        raise FileLimitError(f"{where}: not valid JSON ({escaped(exc)})") from None
     return check_tree(data, where)
