@@ -98,7 +98,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.models",),  # the classes a model file may name, model files, statistics
     ("baselines.policies",),  # one name -> policy table
     ("baselines",),  # the package: its public names
-    ("baselines.evaluation.harness",),  # episodes and the harness
+    ("baselines.evaluation",),  # episodes and the harness
     ("baselines.figures",),  # GIFs, plots, the demo
     ("baselines.agents",),  # training, demonstrations, cloning
     ("baselines.benchmark",),  # grids of training runs and their leaderboard

@@ -303,10 +303,11 @@ def _clone(model: Any, cfg: TrainConfig, deadline: float | None = None) -> dict[
 
     demos = load_demos(cfg.demos)  # type: ignore[arg-type]
     if demos.env_id != cfg.env_id:
-        raise ValueError(f"demos: recorded on {demos.env_id!r}, training on {cfg.env_id!r}")
+        raise ValueError(f"demos: {cfg.demos}: recorded on {demos.env_id!r}, training on "
+                         f"{cfg.env_id!r}")  # fmt: skip
     if demos.observations.shape[1:] != model.observation_space.shape:
         raise ValueError(
-            f"demos: observations of shape {demos.observations.shape[1:]} do not fit "
+            f"demos: {cfg.demos}: observations of shape {demos.observations.shape[1:]} do not fit "
             f"{cfg.env_id}'s {model.observation_space.shape}; re-record them with `sgc demos`"
         )
     set_statistics(model.policy, demos.observations)

@@ -8,7 +8,6 @@ where it was; every file is written atomically.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,6 +17,7 @@ from baselines.benchmark.claims import RunClaims
 from baselines.benchmark.execute import FAILED_FILE, RESULT_FILE, write_outcome
 from baselines.benchmark.grid import RunSpec, build_grid, load_recipes, recipes_from_algos
 from baselines.benchmark.report import write_report
+from baselines.benchmark.results import read_record
 
 __all__ = ["benchmark_grid", "collect_results", "pending_runs", "report", "run_grid"]
 
@@ -106,12 +106,13 @@ def run_grid(
 def collect_results(
     grid: Sequence[RunSpec], root: Path
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """``(results, failed)``: the ``result.json`` and ``failed.json`` of the grid's runs."""
-    def read(name: str) -> list[dict[str, Any]]:
-        paths = [s.folder(root) / name for s in grid]
-        return [json.loads(p.read_text()) for p in paths if p.is_file()]
+    """``(results, failed)``: the ``result.json`` and ``failed.json`` of the grid's runs, each
+    checked (:func:`~baselines.benchmark.results.read_record`: a ValueError naming the file)."""
+    def read(name: str, finished: bool) -> list[dict[str, Any]]:
+        paths = [(s, s.folder(root) / name) for s in grid]
+        return [read_record(p, s, finished=finished) for s, p in paths if p.is_file()]
 
-    return read(RESULT_FILE), read(FAILED_FILE)
+    return read(RESULT_FILE, True), read(FAILED_FILE, False)
 
 
 def report(

@@ -21,6 +21,7 @@ __all__ = [
     "goal_table",
     "goals_met_line",
     "make_console",
+    "smoothness_line",
     "print_training",
     "scorecard_table",
     "summary_line",
@@ -284,3 +285,19 @@ def print_training(result: Any, cfg: Any, out: Any) -> None:
     else:
         print("not evaluated (add --eval-freq N or --eval-every-s S to score the model with the "
               "harness)")  # fmt: skip
+
+def smoothness_line(card: dict[str, Any]) -> str:
+    """The episode's smoothness, linear and angular: LDLJ over the track (mean over bodies),
+    peak acceleration and the largest one-tick change of acceleration (the largest over
+    bodies; docs/metrics.md)."""
+    parts = []
+    for prefix, unit, name in (("", "m/s²", "linear"), ("angular_", "rad/s²", "angular")):
+        values = [card[f"{prefix}{k}"] for k in
+                  ("ldlj_track_mean", "acceleration_peak", "acceleration_kink")]  # fmt: skip
+        if all(isinstance(v, float) and math.isnan(v) for v in values):
+            continue
+        parts.append(
+            f"{name}: LDLJ track {values[0]:.2f}, peak acceleration {values[1]:.3g} {unit}, "
+            f"largest one-tick change of acceleration {values[2]:.3g} {unit}"
+        )
+    return "; ".join(parts) if parts else "no movement to score for smoothness"

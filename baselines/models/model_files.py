@@ -27,6 +27,15 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from sgc_env.scenario.bounded import (
+    FileLimitError,
+    check_count,
+    escaped,
+    load_json,
+    read_bounded,
+)
+from sgc_env.scenario.caps import cap
+
 __all__ = [
     "MOVED_MODULES",
     "ModelFileError",
@@ -43,6 +52,9 @@ TRUST_WARNING = (
 )
 _CLASS_REPR = re.compile(r"<class '([\w.]+)'>")
 _FUNCTION_OWNER = re.compile(r"<function ([\w.]+)\.\w+ at 0x[0-9a-f]+>")
+#: ``'key': Box(low, high, (shape,), dtype)`` in a Dict space's repr; ``[^()]*`` where a lazy
+#: ``.*?`` would try every later position (time growing with the square of the text).
+_DICT_SPACE = re.compile(r"'(\w+)': \w+\([^()]*?, \(([\d, ]*)\), (\w+)\)")
 _NUMBER = r"[-+]?(?:\d+\.?\d*(?:e[-+]?\d+)?|inf|nan)"
 _SCHEDULE_VALUE = re.compile(rf"(?:val|start|initial_value)=({_NUMBER})")
 #: Fields SB3 saves from the last rollout or for training only; ``None`` restarts them.
@@ -96,33 +108,96 @@ def allowed_classes() -> dict[str, type]:
 
 
 def _fail(path: str, problem: str) -> ModelFileError:
-    return ModelFileError(f"model file {path}: {problem}")
+    return ModelFileError(f"model file {escaped(path, 400)}: {problem}")
+
+
+#: The ``.pth`` members SB3's algorithms write (PPO/A2C: policy and its optimizer; SAC/TD3:
+#: the actor's and critics' optimizers, SAC's entropy coefficient's).
+_WEIGHT_MEMBERS = frozenset({"policy.pth", "policy.optimizer.pth", "pytorch_variables.pth",
+                             "actor.optimizer.pth", "critic.optimizer.pth",
+                             "ent_coef_optimizer.pth"})  # fmt: skip
+#: The tensors SB3 keeps in ``pytorch_variables.pth`` (SAC's entropy coefficient); SB3 sets
+#: each key as an attribute path of the model, so no other key may reach it.
+_TORCH_VARIABLES = frozenset({"log_ent_coef", "ent_coef_tensor"})
+
+
+def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, path: str) -> bytes:
+    """A member's bytes, read no further than the cap (a member may lie about its size)."""
+    limit = cap("zip_member_bytes" if info.filename != "data" else "file_bytes")
+    with archive.open(info) as member:
+        blob = member.read(limit + 1)
+    check_count(len(blob), "zip_member_bytes" if info.filename != "data" else "file_bytes",
+                f"model file {path}: member {escaped(info.filename)!r}")  # fmt: skip
+    return blob
 
 
 def read_model_data(blob: bytes, path: str) -> tuple[dict[str, Any], list[str]]:
     """The JSON of the zip's ``data`` member (nothing unpickled) and the member names."""
+    data, members = _read_members(blob, path)
+    return data, list(members)
+
+
+def _read_members(blob: bytes, path: str) -> tuple[dict[str, Any], dict[str, bytes]]:
+    """The JSON of the ``data`` member and every member's bytes; the members' number and
+    declared sizes are checked against the caps before any is read."""
+    members: dict[str, bytes] = {}
     try:
         with zipfile.ZipFile(io.BytesIO(blob)) as archive:
-            names = archive.namelist()
+            infos = archive.infolist()
+            names = [i.filename for i in infos]
+            check_count(len(infos), "zip_members", f"model file {path}: members")
+            for info in infos:
+                check_count(info.file_size, "zip_member_bytes",
+                            f"model file {path}: member {escaped(info.filename)!r}")  # fmt: skip
+            check_count(sum(i.file_size for i in infos), "model_file_bytes",
+                        f"model file {path}: members in all")  # fmt: skip
             missing = [m for m in ("data", "policy.pth") if m not in names]
             if missing:
                 raise _fail(path, f"missing member(s) {missing}: not a Stable-Baselines3 model")
-            text = archive.read("data").decode("utf-8")
-            for name in names:  # reads every member once: a truncated or corrupt one fails here
-                archive.read(name)
-    except (zipfile.BadZipFile, EOFError, OSError, UnicodeDecodeError) as exc:
-        raise _fail(path, f"not a readable zip archive (truncated or corrupt: {exc})") from None
-    except (ValueError, RuntimeError) as exc:  # zlib / CRC errors inside a member
+            for info in infos:  # reads every member once: a truncated or corrupt one fails here
+                members[info.filename] = _read_member(archive, info, path)
+    except FileLimitError as exc:
+        raise ModelFileError(str(exc)) from None
+    except (zipfile.BadZipFile, EOFError, OSError) as exc:
+        raise _fail(path, f"not a readable zip archive (truncated or corrupt: "
+                          f"{escaped(exc)})") from None  # fmt: skip
+    except (ValueError, RuntimeError, MemoryError) as exc:  # zlib / CRC errors inside a member
         if isinstance(exc, ModelFileError):
             raise
-        raise _fail(path, f"corrupt member ({exc})") from None
+        raise _fail(path, f"corrupt member ({escaped(exc)})") from None
     try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise _fail(path, f"member 'data' is not JSON ({exc.msg} at {exc.pos})") from None
+        data = load_json(members["data"], f"model file {path}: member 'data'")
+    except FileLimitError as exc:
+        raise ModelFileError(str(exc)) from None
     if not isinstance(data, dict):
         raise _fail(path, "member 'data' is not a JSON object")
-    return data, names
+    return data, members
+
+
+def _check_weight_members(members: dict[str, bytes], path: str) -> None:
+    """Only SB3's ``.pth`` members, and ``pytorch_variables.pth`` only SB3's own tensors:
+    SB3 turns member names and that file's keys into attribute paths of the model."""
+    import torch as th
+
+    foreign = sorted(n for n in members if n.endswith(".pth") and n not in _WEIGHT_MEMBERS)
+    if foreign:
+        raise _fail(path, f"member(s) {escaped(foreign)} are not weights SB3 writes "
+                          f"(known: {sorted(_WEIGHT_MEMBERS)})")  # fmt: skip
+    if "pytorch_variables.pth" not in members:
+        return
+    try:
+        variables = th.load(io.BytesIO(members["pytorch_variables.pth"]), map_location="cpu",
+                            weights_only=True)  # fmt: skip
+    except (pickle.UnpicklingError, RuntimeError, ValueError, EOFError, MemoryError) as exc:
+        first = escaped(str(exc).strip().splitlines()[0] if str(exc).strip() else exc)
+        raise _fail(path, f"member 'pytorch_variables.pth' is not plain tensors ({first})"
+                    ) from None  # fmt: skip
+    if not isinstance(variables, dict):
+        raise _fail(path, "member 'pytorch_variables.pth' is not a mapping of tensors")
+    for key, value in variables.items():
+        if key not in _TORCH_VARIABLES or not (value is None or isinstance(value, th.Tensor)):
+            raise _fail(path, f"pytorch_variables.pth: key {escaped(repr(key))} is not one of "
+                              f"SB3's tensors {sorted(_TORCH_VARIABLES)}")  # fmt: skip
 
 
 def algorithm_from_data(data: dict[str, Any]) -> str:
@@ -243,7 +318,7 @@ def _space_field(entry: Any, key: str, env_space: gym.Space, path: str) -> gym.S
         if not fits:
             return _mismatch(path, name, _box_summary(entry), env_space)
     elif isinstance(env_space, gym.spaces.Dict):
-        shown = re.findall(r"'(\w+)': \w+\(.*?, \(([\d, ]*)\), (\w+)\)", str(entry.get("spaces")))
+        shown = _DICT_SPACE.findall(str(entry.get("spaces"))[: cap("file_bytes")])
         mine = [(k, ", ".join(map(str, s.shape or ())) + ("," if len(s.shape or ()) == 1 else ""),
                  str(s.dtype)) for k, s in env_space.spaces.items()]  # fmt: skip
         if shown and sorted(shown) != sorted(mine):
@@ -252,21 +327,24 @@ def _space_field(entry: Any, key: str, env_space: gym.Space, path: str) -> gym.S
 
 
 def _mismatch(path: str, name: str, recorded: str, env_space: gym.Space) -> Any:
-    raise _fail(path, f"its {name} {recorded} does not fit this env's {env_space}"
+    raise _fail(path, f"its {name} {escaped(recorded)} does not fit this env's {env_space}"
                       f"{_trained_on(path)}")  # fmt: skip
 
 
 def _trained_on(path: str) -> str:
-    """`` (trained on ID)`` from a ``config.json`` or ``manifest.json`` beside the file."""
+    """`` (trained on ID)`` from a ``config.json`` or ``manifest.json`` beside the file (read
+    within the caps; its text escaped)."""
     folder, name = Path(path).parent, Path(path).name
     try:
         config = folder / "config.json"
         if config.is_file():
-            return f" (trained on {json.loads(config.read_text())['env_id']})"
+            env_id = load_json(read_bounded(config, "config"), str(config))["env_id"]
+            return f" (trained on {escaped(env_id, 80)})"
         manifest = folder / "manifest.json"
         if manifest.is_file():
-            entries = json.loads(manifest.read_text())
-            return next(f" (trained on {e['env_id']})" for e in entries if e["file"] == name)
+            entries = load_json(read_bounded(manifest, "manifest"), str(manifest))
+            return next(f" (trained on {escaped(e['env_id'], 80)})" for e in entries
+                        if e["file"] == name)  # fmt: skip
     except (ValueError, KeyError, TypeError, StopIteration, OSError):
         pass
     return ""
@@ -304,6 +382,22 @@ def safe_custom_objects(
     return objects
 
 
+def _check_network(data: dict[str, Any], env: Any, path: str) -> None:
+    """The network sizes the file's ``policy_kwargs`` shows (:mod:`baselines.common.network_caps`),
+    before SB3 builds them."""
+    from baselines.common.network_caps import check_policy_kwargs
+
+    kwargs = data.get("policy_kwargs")
+    if not isinstance(kwargs, dict):
+        return
+    space = getattr(env, "observation_space", None)
+    inputs = int(np.prod(space.shape)) if isinstance(space, gym.spaces.Box) else 1
+    try:
+        check_policy_kwargs(kwargs, "policy_kwargs", inputs)
+    except ValueError as exc:
+        raise _fail(path, str(exc)) from None
+
+
 def load_sb3_model(
     path: str | Path, env: Any | None = None, device: str = "cpu", trust_model: bool = False
 ) -> Any:
@@ -317,12 +411,16 @@ def load_sb3_model(
     if not file.is_file():
         raise ValueError(f"policy: model file {name!r} "
                          f"{'is a folder' if file.is_dir() else 'does not exist'}")  # fmt: skip
-    blob = file.read_bytes()  # read once: what is checked is what loads
-    data, _ = read_model_data(blob, name)
+    try:
+        blob = read_bounded(file, "model file", "model_file_bytes")  # once: what is checked loads
+    except FileLimitError as exc:
+        raise ModelFileError(str(exc)) from None
+    data, members = _read_members(blob, name)
     try:
         algo = algorithm_from_data(data)
     except ValueError as exc:
-        raise _fail(name, str(exc)) from None
+        raise _fail(name, escaped(exc)) from None
+    _check_network(data, env, name)
     algorithm = getattr(importlib.import_module("stable_baselines3"), algo)
     if trust_model:
         objects = None
@@ -330,15 +428,17 @@ def load_sb3_model(
         raise _fail(name, "safe loading rebuilds the spaces from the env: pass env")
     else:
         objects = safe_custom_objects(data, env, name, algorithm)
+        _check_weight_members(members, name)
     try:
         model = algorithm.load(io.BytesIO(blob), env=env, device=device, custom_objects=objects)
     except pickle.UnpicklingError as exc:
-        first = str(exc).splitlines()[0]
+        first = escaped(str(exc).splitlines()[0])
         raise _fail(name, "its weights hold objects other than tensors, refused by torch's "
                           f"weights_only loading ({first})") from None  # fmt: skip
-    except (RuntimeError, KeyError, TypeError, AssertionError, ValueError) as exc:
+    except (RuntimeError, KeyError, TypeError, AssertionError, ValueError, AttributeError,
+            MemoryError, RecursionError) as exc:  # fmt: skip
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise _fail(name, f"does not load as a {algo} for this env: {first}") from None
+        raise _fail(name, f"does not load as a {algo} for this env: {escaped(first)}") from None
     bind = getattr(model.policy, "bind_env", None)
     if env is not None and bind is not None:  # PerBodyPolicy: the env's action gains
         bind(env)

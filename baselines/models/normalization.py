@@ -28,6 +28,7 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.common.atomic_files import write_atomic
+from sgc_env.scenario.bounded import escaped, load_json, read_bounded
 
 __all__ = [
     "FORMAT",
@@ -89,7 +90,7 @@ def save_statistics(vec_normalize: Any, path: str | Path) -> Path:
 
 def _number(value: Any, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ValueError(f"{where} must be a finite number, got {value!r}")
+        raise ValueError(f"{where} must be a finite number, got {escaped(repr(value))}")
     return float(value)
 
 
@@ -98,19 +99,41 @@ def _rms(entry: Any, where: str, shape: tuple[int, ...]) -> Any:
 
     if not isinstance(entry, dict) or not {"shape", "mean", "var", "count"} <= set(entry):
         raise ValueError(f"{where}: expected shape, mean, var and count")
-    if list(entry["shape"]) != list(shape):
-        raise ValueError(f"{where}: statistics of shape {tuple(entry['shape'])} do not fit the "
+    if not isinstance(entry["shape"], list) or entry["shape"] != list(shape):
+        raise ValueError(f"{where}: statistics of shape {escaped(entry['shape'])} do not fit the "
                          f"env's observations of shape {shape}")  # fmt: skip
     rms = RunningMeanStd(shape=shape)
     try:
         rms.mean = np.asarray(entry["mean"], np.float64).reshape(shape)
         rms.var = np.asarray(entry["var"], np.float64).reshape(shape)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{where}: mean and var must be {shape} numbers ({exc})") from None
-    if not (np.all(np.isfinite(rms.mean)) and np.all(rms.var >= 0)):
-        raise ValueError(f"{where}: mean must be finite and var >= 0")
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ValueError(f"{where}: mean and var must be {shape} numbers ({escaped(exc)})"
+                         ) from None  # fmt: skip
+    if not (np.all(np.isfinite(rms.mean)) and np.all(np.isfinite(rms.var))
+            and np.all(rms.var >= 0)):  # fmt: skip
+        raise ValueError(f"{where}: mean and var must be finite and var >= 0 (an infinite "
+                         "variance scales every observation to 0)")  # fmt: skip
     rms.count = _number(entry["count"], f"{where}.count")
+    if rms.count < 0:
+        raise ValueError(f"{where}.count must be >= 0, got {rms.count}")
     return rms
+
+
+#: Setting -> (low, high) it must lie in: clipping at 0 or below zeroes every observation.
+_RANGES = {"clip_obs": (1e-6, math.inf), "clip_reward": (1e-6, math.inf), "gamma": (0.0, 1.0),
+           "epsilon": (0.0, 1.0)}  # fmt: skip
+
+
+def _setting(state: dict[str, Any], key: str, where: str) -> Any:
+    if key.startswith("norm"):
+        if not isinstance(state[key], bool):
+            raise ValueError(f"{where}.{key} must be true or false, got {escaped(state[key])}")
+        return state[key]
+    value = _number(state[key], f"{where}.{key}")
+    low, high = _RANGES[key]
+    if not low <= value <= high:
+        raise ValueError(f"{where}.{key} must be in [{low:g}, {high:g}], got {value:g}")
+    return value
 
 
 def _from_state(state: Any, env: Any, where: str) -> Any:
@@ -128,15 +151,16 @@ def _from_state(state: Any, env: Any, where: str) -> Any:
         if isinstance(space, gym.spaces.Dict):
             keys = state.get("norm_obs_keys") or list(space.spaces)
             entries = state.get("obs_rms")
-            if not isinstance(entries, dict) or not set(keys) <= set(entries) & set(space.spaces):
+            if (not isinstance(keys, list) or not all(isinstance(k, str) for k in keys)
+                    or not isinstance(entries, dict)
+                    or not set(keys) <= set(entries) & set(space.spaces)):  # fmt: skip
                 raise ValueError(f"{where}: obs_rms keys do not fit the env's {list(space.spaces)}")
             obs_rms = {k: _rms(entries[k], f"{where}: obs_rms[{k!r}]", tuple(space[k].shape or ()))
                        for k in keys}  # fmt: skip
         else:
             obs_rms = _rms(state.get("obs_rms"), f"{where}: obs_rms", tuple(space.shape or ()))
     vec_normalize = VecNormalize.__new__(VecNormalize)
-    settings = {k: bool(state[k]) if k.startswith("norm") else _number(state[k], f"{where}.{k}")
-                for k in _SETTINGS}  # fmt: skip
+    settings = {k: _setting(state, k, where) for k in _SETTINGS}
     vec_normalize.__setstate__({
         **settings, "norm_obs_keys": state.get("norm_obs_keys"), "obs_rms": obs_rms,
         "ret_rms": _rms(state.get("ret_rms"), f"{where}: ret_rms", ()), "training": False,
@@ -172,11 +196,9 @@ def load_statistics(path: str | Path, env: Any, trust_model: bool = False) -> An
                              f"{type(vec_normalize).__name__}, not a VecNormalize")  # fmt: skip
         vec_normalize.training = False
         return vec_normalize
-    try:
-        state = json.loads(file.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ValueError(f"VecNormalize statistics {file}: unreadable ({exc})") from None
-    return _from_state(state, env, f"VecNormalize statistics {file}")
+    where = f"VecNormalize statistics {escaped(file)}"
+    state = load_json(read_bounded(file, "VecNormalize statistics"), where)
+    return _from_state(state, env, where)
 
 
 def convert_pickle(path: str | Path) -> Path:

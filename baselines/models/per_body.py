@@ -23,6 +23,7 @@ the other policy kwargs) and again, for the env a saved model is loaded on, by
 
 from __future__ import annotations
 
+import re
 import warnings
 from functools import partial
 from typing import Any
@@ -37,6 +38,7 @@ from torch import nn
 
 from baselines.common.env_model import EnvModel
 from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
+from sgc_env.scenario.bounded import escaped
 
 __all__ = [
     "BODY_ACTIONS",
@@ -47,6 +49,8 @@ __all__ = [
 ]
 
 BODY_ACTIONS = 6
+_SGC_ID = re.compile(r"SGC[A-Za-z0-9]{1,60}-v\d{1,4}")
+"""The ids ``gains_env`` may name: this package's (registered or renamed), no other env's."""
 BODY_FEATURES = 2 * TRACK_FEATURES
 """What the shared net reads of each body: the two tracks' features (the gravity column of
 :class:`ScheduleFeatures` is dropped: the hover is in the action map)."""
@@ -181,8 +185,13 @@ class PerBodyPolicy(ActorCriticPolicy):
             raise ValueError(f"PerBodyPolicy needs a Box of 6 actions per body, got {action_space}")
         self.n_bodies = n
         self._initial_gains = (np.ones((n, BODY_ACTIONS)), np.zeros((n, BODY_ACTIONS)))
-        import sgc_env  # noqa: F401  (registers the ids)
+        import sgc_env  # registers the ids
 
+        if gains_env is not None and not (isinstance(gains_env, str)
+                                          and _SGC_ID.fullmatch(gains_env)):  # fmt: skip
+            # a file names it: only an SGC env is built here, never another registered one
+            raise ValueError(f"PerBodyPolicy: gains_env must be an SGC env id "
+                             f"({', '.join(sgc_env.ENV_IDS)}), got {escaped(repr(gains_env))}")
         if gains_env is not None and gains_env not in gym.registry:
             # a saved model whose id was renamed still loads: its gains come back from the
             # file's buffers, and the loader re-binds them to the env it is loaded on

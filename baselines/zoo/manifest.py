@@ -17,6 +17,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from baselines.common.env_kwargs import check_env_kwargs
+from sgc_env.scenario.bounded import load_json, read_bounded
+
 __all__ = [
     "CHECKPOINTS",
     "ENTRY_FIELDS",
@@ -44,7 +47,7 @@ def load_manifest(folder: str | Path = CHECKPOINTS) -> list[dict[str, Any]]:
     path = Path(folder) / MANIFEST_NAME
     if not path.is_file():
         return []
-    entries = json.loads(path.read_text())
+    entries = load_json(read_bounded(path, "manifest"), str(path))
     if not isinstance(entries, list):
         raise ValueError(f"{path}: expected a list of entries")
     for i, entry in enumerate(entries):
@@ -123,7 +126,9 @@ def ship_model(
     if (run_dir / "vecnormalize.pkl").is_file() and not (run_dir / "vecnormalize.json").is_file():
         raise ValueError(f"run: {run_dir}/vecnormalize.pkl is a pickle; convert it first "
                          "(scripts/convert_models.py, only for a run you trust)")  # fmt: skip
-    config = json.loads(config_path.read_text())
+    config = load_json(read_bounded(config_path, "run config"), str(config_path))
+    if not isinstance(config, dict) or not isinstance(config.get("train_config", {}), dict):
+        raise ValueError(f"{config_path}: expected a `sgc train` config object")
     root = Path(folder)
     target = root / f"{name}.zip"
     shutil.copyfile(source, target)
@@ -131,9 +136,12 @@ def ship_model(
     if stats.is_file():
         shutil.copyfile(stats, root / f"{name}.vecnormalize.json")
     command_file = run_dir / "command.txt"  # written by `sgc benchmark`, path resolved
-    command = command_file.read_text().strip() if command_file.is_file() else config["command"]
+    command = (read_bounded(command_file, "command").decode("utf-8", "replace").strip()
+               if command_file.is_file() else config["command"])  # fmt: skip
     train_config = config.get("train_config", {})
     env_kwargs = train_config.get("env_kwargs") or None
+    if env_kwargs is not None:
+        check_env_kwargs(config["env_id"], env_kwargs, f"{config_path}: env_kwargs")
     entry = {
         "file": target.name, "env_id": config["env_id"], "algo": config["algo"],
         "demonstrations": train_config.get("init") == "bc",

@@ -14,10 +14,9 @@ from __future__ import annotations
 
 import argparse
 import shlex
-import sys
 from pathlib import Path
 
-from baselines.cli.checks import env_kwargs
+from baselines.cli.checks import env_kwargs, error_exit, out_dir
 from baselines.cli.console import make_console
 
 __all__ = ["add_arguments", "run"]
@@ -71,7 +70,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="episodes per learning-curve point (they pick the best model)",
     )
     parser.add_argument("--eval-seed", type=int, default=10_000, help="first learning-curve seed")
-    parser.add_argument("--out", type=Path, default=Path("runs/benchmark"))
+    parser.add_argument("--out", type=out_dir, default=Path("runs/benchmark"),
+                        help="folder of the runs and the leaderboard")  # fmt: skip
     parser.add_argument("--backend", choices=("local", "ray"), default="local")
     parser.add_argument(
         "--workers",
@@ -111,8 +111,7 @@ def run(args: argparse.Namespace) -> int:
         )  # fmt: skip
         backend = make_backend(args.backend, args.workers, args.address, args.cpus_per_run)
     except ValueError as exc:
-        print(f"sgc benchmark: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("benchmark", exc)
     root = args.out
     finished, failed_before, todo = pending_runs(grid, root, args.retry_failed)
     todo = [] if args.report_only else todo
@@ -128,7 +127,10 @@ def run(args: argparse.Namespace) -> int:
     meta = {"command": shlex.join(["sgc", *(w for w in argv if w != "--report-only")]),
             "eval_episodes": args.eval_episodes, "test_seed": args.test_seed,
             "eval_seed": args.eval_seed}  # fmt: skip
-    written, failed = report(grid, root, meta, plots=not args.no_plots)
+    try:
+        written, failed = report(grid, root, meta, plots=not args.no_plots)
+    except ValueError as exc:
+        return error_exit("benchmark", exc)
     print((root / "leaderboard.md").read_text())
     print("wrote " + ", ".join(str(p) for p in written))
     return 1 if failed else 0

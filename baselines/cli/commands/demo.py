@@ -12,7 +12,6 @@ included: the measure that matters on a shared machine) and the wall time.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from typing import Any
 from baselines.cli.checks import (
     add_trust_argument,
     bounded_int,
+    error_exit,
     out_dir,
     staged_output,
     trust_model,
@@ -103,8 +103,7 @@ def run(args: argparse.Namespace) -> int:
             check_policy(option)
         return _fly(args, options, labels)
     except ValueError as exc:
-        print(f"sgc demo: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("demo", exc)
 
 
 def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int:

@@ -9,13 +9,13 @@ DIR also gets ``scorecard.json`` and ``scorecard.md``, the comparison table prin
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from baselines.cli.checks import (
     add_trust_argument,
+    error_exit,
     known_env_id,
     nonneg_float,
     nonneg_int,
@@ -112,8 +112,7 @@ def run(args: argparse.Namespace) -> int:
         for env_id in envs:
             known_env_id(env_id)
     except ValueError as exc:
-        print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("evaluate", exc)
     single = len(policies) == 1 and len(envs) == 1
     root = args.out or Path("runs/evaluate", *([envs[0], labels[0]] if single else []))
     pairs = evaluate_pairs(
@@ -133,8 +132,7 @@ def run(args: argparse.Namespace) -> int:
                     console.print(show.goal_table(result.rows, args.wide))
                 console.print(f"[dim]{env_id} / {label}: done, goes to {root / folder}[/dim]")
         except ValueError as exc:
-            print(f"sgc evaluate: error: {exc}", file=sys.stderr)
-            return 2
+            return error_exit("evaluate", exc)
         if not single:
             write_scorecard(summaries, stage)
     title = f"{args.episodes} episode(s) from seed {args.seed}"

@@ -98,7 +98,7 @@ def test_hyperparams_errors_name_the_field(tmp_path: Path, tiny_hp: Path) -> Non
         load_hyperparams("ppo", "SGCRod-v0", tiny_hp)
     (tmp_path / "bad").mkdir()
     (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v0: {policy: MlpPolicy\n")
-    with pytest.raises(ValueError, match="bad YAML"):
+    with pytest.raises(ValueError, match="not valid YAML"):
         load_hyperparams("ppo", "SGCPoint-v0", tmp_path / "bad")
     (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v0: {policy: MlpPolicy}\n")
     with pytest.raises(ValueError, match="n_timesteps"):

@@ -77,7 +77,8 @@ rod = dict(rod="rod_gold", goals=25, goals_met=25, position_error_max_m=2.0e-15,
            sparc_track=-2.21, goal_speed_ratio_min=0.68, acceleration_kink=15.1,
            angular_acceleration_kink=29.2)
 result = SimpleNamespace(label="expert", per_rod=[rod] * 3)
-make_console().print(demo_scorecard_table(SimpleNamespace(policy="expert", end_rule="tangent"), result))
+option = SimpleNamespace(policy="expert", end_rule="tangent")
+make_console().print(demo_scorecard_table(option, result))
 """
 
 

@@ -26,14 +26,14 @@ BASE = ("SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_steps: 64\n"
 
 #: hyperparameter file -> fragment of the error (each line replaces or extends BASE)
 HYPERPARAMS = {
-    "  learning_rate: [1, 2]\n": "learning_rate: expected a number or lin_<number>",
+    "  learning_rate: [1, 2]\n": "learning_rate: expected a finite number > 0 or lin_<number>",
     "  gamma: high\n": "gamma must be a finite number, got 'high'",
     "  batch_size: true\n": "batch_size must be an integer, got True",
     "  n_epochs: '2'\n": "n_epochs must be an integer, got '2'",
     "  n_timesteps: 1e400\n": "must be finite numbers",
     "  policy_kwargs: 'dict(activation_fn=os.system)'\n": "name 'os.system' is not allowed",
     "  policy_kwargs: \"__import__('os').system('x')\"\n": "unsupported expression",
-    "  policy_kwargs: {net_arch: x}\n": "hyperparameters of ppo for SGCPoint-v0",
+    "  policy_kwargs: {net_arch: x}\n": "policy_kwargs.net_arch: expected a list of layer",
     "  normalize: 'dict(clip_obs=\"x\")'\n": "normalize: clip_obs must be a finite number",
     "  normalize: {norm_obs: 1}\n": "normalize: norm_obs must be true/false",
     "  policy: [MlpPolicy]\n": "policy must be a name",
@@ -81,7 +81,7 @@ RECIPES = {
     "{algo: ppo, env_kwargs: {foo: 1}}": "env_kwargs: SGCPoint-v0 does not take {'foo': 1}",
     "{algo: [ppo]}": "algo must be one of",
     "[1, 2]": "expected a mapping, got list",
-    "{algo: ppo}\n\t- tab": "bad YAML: while scanning",
+    "{algo: ppo}\n\t- tab": "not valid YAML: while scanning",
 }
 
 
@@ -125,11 +125,11 @@ def test_demonstrations_with_a_pickled_array_are_refused(tmp_path: Path) -> None
     marker = tmp_path / "pwned"
     path = tmp_path / "d.npz"
     np.savez(path, observations=np.array([_Payload(marker)], dtype=object), format_version=1)
-    with pytest.raises(ValueError, match="not a demonstrations file"):
+    with pytest.raises(ValueError, match="holds Python objects"):
         load_demos(path)
     assert not marker.exists()
     path.write_bytes(b"PK\x03\x04 truncated")
-    with pytest.raises(ValueError, match=f"demos: {path} is not a demonstrations file"):
+    with pytest.raises(ValueError, match=f"demos: {path}: not a readable npz"):
         load_demos(path)
 
 

@@ -215,7 +215,7 @@ MALFORMED = {
     "truncated": (_truncated, "truncated or corrupt"),
     "no data": (_no_data, "missing member(s) ['data']"),
     "no weights": (_no_weights, "missing member(s) ['policy.pth']"),
-    "data not json": (_not_json, "member 'data' is not JSON"),
+    "data not json": (_not_json, "member 'data': not valid JSON"),
     "class off the allow-list": (_foreign_class, "'subprocess.Popen', which is not on the"),
     "field shadowing a method": (_shadowing_field, "would replace PPO.predict"),
     "other env's spaces": (_other_env, "action space Box(shape=(6,), float32) does not fit"),

@@ -280,13 +280,13 @@ CASES: list[tuple[str, Mutation, str, str]] = [
         "path": {"start": [0, 0, 1]}, "samples": 3}), "bodies[0].goals[1].path.curve", "missing"),
     ("curve parameters wrong", lambda d: ball(d)["goals"].insert(1, {
         "path": {"curve": "line", "start": [0, 0, 1]}, "samples": 3}),
-     "bodies[0].goals[1].path", "bad parameters"),
+     "bodies[0].goals[1].path.end", "missing required field"),
     ("helix 1e9 turns", lambda d: ball(d)["goals"].insert(1, {
         "path": {"curve": "helix", "center": [0.5, 0, 1], "radius": 0.1, "turns": 1e9,
                  "height": 0.1}, "samples": 3}), "bodies[0].goals[1].path.turns", "at most"),
     ("curve radius inf", lambda d: ball(d)["goals"].insert(1, {
         "path": {"curve": "arc", "center": [0.5, 0, 1], "radius": math.inf, "start_angle": 0,
-                 "end_angle": 1}, "samples": 3}), "bodies[0].goals[1].path", "non-finite"),
+                 "end_angle": 1}, "samples": 3}), "bodies[0].goals[1].path.radius", "finite"),
     ("path goal unknown field", lambda d: ball(d)["goals"].insert(1, {
         "path": {"curve": "line", "start": [0, 0, 1], "end": [1, 0, 1]}, "samples": 3,
         "orientation": [0, 0, 0, 1]}), "bodies[0].goals[1]", "unknown field"),
@@ -380,14 +380,14 @@ def test_deep_nesting_is_named(tmp_path):
     path = tmp_path / "deep.yaml"
     path.write_text("bodies: " + "[" * 5000 + "]" * 5000)
     # libyaml stops at its nesting limit; the pure-Python reader runs out of recursion
-    with pytest.raises(ScenarioError, match="(?s)deep: (nested too deeply|.*nesting depth)"):
+    with pytest.raises(ScenarioError, match="(?s)deep.yaml: (nested too deeply|.*nesting depth)"):
         load_scenario(path)
 
 
 def test_broken_yaml_is_named(tmp_path):
     path = tmp_path / "broken.yaml"
     path.write_text("bodies: [\n")
-    with pytest.raises(ScenarioError, match="broken: not valid YAML"):
+    with pytest.raises(ScenarioError, match="broken.yaml: not valid YAML"):
         load_scenario(path)
 
 
