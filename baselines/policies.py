@@ -4,14 +4,14 @@ Specs: ``expert`` (SGC with the scenario's end-velocity rule, by default the tan
 ``expert-paper`` (SGC with the paper's k rules, eqs. 12-14), ``expert-matched`` (SGC with
 end velocities solved over whole tracks so accelerations match, :mod:`sgc_env.paper.matched`),
 ``expert-smooth`` (SGC sub-courses between transient sub-goals on the minimum-jerk reference,
-:mod:`baselines.smooth_table`), ``dynamic-constraints``,
+:mod:`baselines.controllers.smooth_table`), ``dynamic-constraints``,
 ``minimum-jerk``, ``random``, ``shipped:<env id>`` (a model packaged with the project,
-:mod:`baselines.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
+:mod:`baselines.common.shipped`), or the path of a Stable-Baselines3 model ``.zip`` (PPO, SAC,
 TD3, A2C, DDPG; the algorithm is read from the saved data, SB3 and torch are imported only
-then). Model files are loaded without unpickling anything (:mod:`baselines.model_files`)
+then). Model files are loaded without unpickling anything (:mod:`baselines.models.model_files`)
 unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model trained
 behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
-(:func:`vecnormalize_path`, :mod:`baselines.normalization`), so it sees the observations it
+(:func:`vecnormalize_path`, :mod:`baselines.models.normalization`), so it sees the observations it
 was trained on. Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
@@ -20,14 +20,15 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
 
-from baselines.comparison_policies import (
+from baselines.common.shipped import resolve_policy_spec
+from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
     MinimumJerkController,
     episode_model,
@@ -35,13 +36,14 @@ from baselines.comparison_policies import (
     predict_per_env,
     scenario_of,
 )
-from baselines.expert import SGCExpert
-from baselines.model_files import algorithm_from_data, load_sb3_model
-from baselines.normalization import load_statistics, statistics_path
-from baselines.shipped import resolve_policy_spec
+from baselines.controllers.expert import SGCExpert
+from baselines.models.model_files import algorithm_from_data, load_sb3_model
+from baselines.models.normalization import load_statistics, statistics_path
 
 __all__ = [
     "BUILTIN_POLICIES",
+    "POLICY_FACTORIES",
+    "BuiltinPolicy",
     "EpisodeExpert",
     "NormalizedPolicy",
     "Policy",
@@ -55,10 +57,6 @@ __all__ = [
     "vecnormalize_path",
 ]
 
-BUILTIN_POLICIES: tuple[str, ...] = (
-    "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
-    "minimum-jerk", "random",
-)  # fmt: skip
 _TRUST_MODELS: contextvars.ContextVar[bool] = contextvars.ContextVar("trust_models", default=False)
 
 
@@ -67,7 +65,7 @@ class Policy(Protocol):
     """What the harness, the CLI and training callbacks drive: SB3's ``predict`` signature.
 
     The expert, the comparison controllers, :class:`RandomPolicy`, :class:`EpisodeExpert`,
-    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/test_policies.py``).
+    :class:`NormalizedPolicy` and SB3 models all satisfy it (``tests/baselines/test_policies.py``).
     SB3 models default to ``deterministic=False``; the harness always passes True.
     """
 
@@ -190,7 +188,8 @@ def policy_labels(specs: Sequence[str]) -> list[str]:
 
 
 def vecnormalize_path(model_path: str | Path) -> Path | None:
-    """The ``VecNormalize`` statistics saved with a model (see :mod:`baselines.normalization`)."""
+    """The ``VecNormalize`` statistics saved with a model (see
+    :mod:`baselines.models.normalization`)."""
     return statistics_path(model_path)
 
 
@@ -243,35 +242,50 @@ def _one_torch_thread() -> None:
     torch.set_num_threads(1)
 
 
+class BuiltinPolicy(NamedTuple):
+    """How to make a built-in policy: ``make(env, seed)``; ``flat``: it reads the flat SGC
+    observation, so the env is checked for one first."""
+
+    make: Callable[[Any, int | None], Policy]
+    flat: bool = True
+
+
+def _expert(end_rule: str | None) -> BuiltinPolicy:
+    return BuiltinPolicy(lambda env, seed: EpisodeExpert(env, end_rule=end_rule))
+
+
+POLICY_FACTORIES: dict[str, BuiltinPolicy] = {
+    "expert": _expert(None),
+    "expert-paper": _expert("paper"),
+    "expert-matched": _expert("matched"),
+    "expert-smooth": _expert("smooth"),
+    "dynamic-constraints": BuiltinPolicy(lambda env, seed: DynamicConstraintsController(env)),
+    "minimum-jerk": BuiltinPolicy(lambda env, seed: MinimumJerkController(env)),
+    "random": BuiltinPolicy(
+        lambda env, seed: RandomPolicy(_spaces_env(env).action_space, seed), flat=False
+    ),
+}
+"""The built-in policies by name: the one list of them."""
+
+BUILTIN_POLICIES: tuple[str, ...] = tuple(POLICY_FACTORIES)
+
+
 def make_policy(
     spec: str, env: Any, seed: int | None = None, trust_model: bool | None = None
 ) -> Policy:
     """A policy for ``env`` from its spec (see the module docstring); ``seed`` seeds ``random``.
 
     ``trust_model``: unpickle model files (None: as :func:`trusted_models` says, by default
-    not; see :mod:`baselines.model_files`).
+    not; see :mod:`baselines.models.model_files`).
     """
     if not isinstance(spec, str) or not spec:
         raise ValueError(f"policy spec must be a non-empty string, got {spec!r}")
     spec = resolve_policy_spec(spec)
-    if spec == "random":
-        return RandomPolicy(_spaces_env(env).action_space, seed)
-    if spec in (
-        "expert", "expert-paper", "expert-matched", "expert-smooth", "dynamic-constraints",
-        "minimum-jerk",
-    ):  # fmt: skip
-        _needs_flat_observation(env, spec)
-        if spec == "expert":
-            return EpisodeExpert(env)
-        if spec == "expert-paper":
-            return EpisodeExpert(env, end_rule="paper")
-        if spec == "expert-matched":
-            return EpisodeExpert(env, end_rule="matched")
-        if spec == "expert-smooth":
-            return EpisodeExpert(env, end_rule="smooth")
-        if spec == "dynamic-constraints":
-            return DynamicConstraintsController(env)
-        return MinimumJerkController(env)
+    builtin = POLICY_FACTORIES.get(spec)
+    if builtin is not None:
+        if builtin.flat:
+            _needs_flat_observation(env, spec)
+        return builtin.make(env, seed)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
         trust = _TRUST_MODELS.get() if trust_model is None else trust_model
         single = _spaces_env(env)

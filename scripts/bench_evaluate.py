@@ -1,8 +1,8 @@
 """Wall clock of the harness on single envs vs the batched env, measured in one run.
 
 ``evaluate(..., num_envs=1)`` runs the episodes one after another on one env;
-``num_envs=N`` runs them N at a time in one PyBullet world (``baselines.episodes``). Prints
-the median of ``--rounds`` runs of each and their ratio. A model file warms up (imports,
+``num_envs=N`` runs them N at a time in one PyBullet world (``baselines.evaluation.episodes``).
+Prints the median of ``--rounds`` runs of each and their ratio. A model file warms up (imports,
 load) before timing.
 
     PYTHONPATH=$PWD .venv/bin/python scripts/bench_evaluate.py --env SGCRod-v0 \\
@@ -15,7 +15,7 @@ import argparse
 import statistics
 import time
 
-from baselines.evaluation import evaluate
+from baselines.evaluation.harness import evaluate
 
 
 def _timed(policy: str, env_id: str, episodes: int, num_envs: int) -> float:

@@ -29,7 +29,7 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the env ids)
-from baselines.expert import GOAL_TICK_SLACK, SGCExpert
+from baselines.controllers.expert import GOAL_TICK_SLACK, SGCExpert
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_env import BareLoop, env_step_us, fixed_env, hover_action  # noqa: E402

@@ -8,7 +8,7 @@ run (the first ``--configs`` entry), each in a fresh child process, one after th
 ``--steps`` env steps, no evaluation::
 
     .venv/bin/python scripts/bench_recipes.py --env SGCRod-v0 --steps 32768 \
-        --configs ppo_schedule:dummy ppo_schedule:batched ppo_fast:batched ppo_fast_big:batched
+        --configs ppo_schedule:dummy ppo_schedule:batched ppo_rod_alive64:batched ppo_rod300:batched
 """
 
 from __future__ import annotations
@@ -35,7 +35,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--env", default="SGCRod-v0")
     parser.add_argument("--steps", type=int, default=32768, help="env steps per timed run")
-    parser.add_argument("--configs", nargs="+", default=["ppo_schedule:dummy", "ppo_fast:batched"],
+    parser.add_argument("--configs", nargs="+",
+                        default=["ppo_schedule:dummy", "ppo_rod300:batched"],
                         help="FOLDER:VEC; the first is the reference")  # fmt: skip
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)

@@ -37,7 +37,7 @@ import json, os, pkgutil, sys, time
 import numpy as np, gymnasium as gym
 import sgc_env
 from sgc_env.simulator import pybullet as pb
-from baselines.cli.demo_camera import camera_at
+from baselines.figures.demo_camera import camera_at
 w, h, n = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 env = gym.make("SGCThreeRods-v1"); base = env.unwrapped
 loader = pkgutil.get_loader("eglRenderer")
@@ -87,9 +87,9 @@ def main() -> None:
     import gymnasium as gym
 
     import sgc_env  # noqa: F401  (registers the ids)
-    from baselines.cli.demo import DemoScene
-    from baselines.cli.demo_camera import camera_at
-    from baselines.expert import SGCExpert
+    from baselines.controllers.expert import SGCExpert
+    from baselines.figures.demo import DemoScene
+    from baselines.figures.demo_camera import camera_at
     from sgc_env.render import Painter, Trail
     from sgc_env.scenes import three_rods
     from sgc_env.simulator import pybullet as pb

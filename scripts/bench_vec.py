@@ -38,7 +38,7 @@ def child(env_id: str, n: int, kind: str, steps: int, rollout: int) -> dict[str,
     """One measurement (runs in its own process)."""
     import numpy as np
 
-    from baselines.batched import BatchedVecEnv, make_sgc_vec
+    from baselines.agents.sb3_vec_env import BatchedVecEnv, make_sgc_vec
 
     before = _rss_mb(False)
     env = BatchedVecEnv(env_id, n) if kind == "batched" else make_sgc_vec(env_id, n, vec=kind)

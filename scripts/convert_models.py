@@ -4,7 +4,7 @@
 
 For each ``*.vecnormalize.pkl`` / ``vecnormalize.pkl`` / ``*_vecnormalize_<N>_steps.pkl``
 (a file, or found in a folder) it writes the JSON statistics beside it and deletes the pickle
-(:mod:`baselines.normalization`); for each ``.zip`` it drops the fields SB3 pickles from the
+(:mod:`baselines.models.normalization`); for each ``.zip`` it drops the fields SB3 pickles from the
 last rollout (``_last_obs``, episode buffers ...), which prediction does not read, keeping
 every other member byte for byte. This UNPICKLES the ``.pkl`` files: run it only on files
 you made or trust.
@@ -18,10 +18,10 @@ import json
 import zipfile
 from pathlib import Path
 
-from baselines.atomic_files import write_atomic
-from baselines.benchmark.manifest import CHECKPOINTS
-from baselines.model_files import read_model_data
-from baselines.normalization import convert_pickle
+from baselines.common.atomic_files import write_atomic
+from baselines.models.model_files import read_model_data
+from baselines.models.normalization import convert_pickle
+from baselines.zoo.manifest import CHECKPOINTS
 
 #: Fields SB3 pickles from the last rollout; null in a converted zip.
 RUNTIME_FIELDS = ("_last_obs", "_last_original_obs", "_last_episode_starts",

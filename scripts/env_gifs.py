@@ -12,7 +12,7 @@ import argparse
 from pathlib import Path
 
 import sgc_env  # noqa: F401  (registers the ids)
-from baselines.episode_gif import episode_gif
+from baselines.figures.episode_gif import episode_gif
 from sgc_env.env_cards import CARDS, gif_path
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"

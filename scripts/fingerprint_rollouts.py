@@ -75,7 +75,7 @@ def random_episode(env_id: str, seed: int, digest: Any) -> None:
 
 def expert_actions(env_id: str, seed: int) -> np.ndarray:
     """The expert's actions on one episode (imported here only: recording needs baselines)."""
-    from baselines.expert import SGCExpert
+    from baselines.controllers.expert import SGCExpert
 
     env = gym.make(env_id)
     obs, _ = env.reset(seed=seed)

@@ -22,7 +22,7 @@ from packaging.requirements import Requirement
 from packaging.utils import canonicalize_name
 
 ROOT = Path(__file__).resolve().parents[1]
-EXTRAS = ("rl", "ray", "dev", "minari")
+EXTRAS = ("rl", "ray", "dev", "minari", "docs")
 HEADER = (
     "# Tested versions: written by scripts/freeze_constraints.py from the working venv\n"
     "# (Python {python}). scripts/setup.sh installs with `pip install -c constraints.txt`.\n"

@@ -16,7 +16,7 @@ import argparse
 import sys
 from typing import Any
 
-from baselines.evaluation import evaluate
+from baselines.evaluation.harness import evaluate
 from sgc_env.defaults import EVAL_SEED
 
 FIGURES = ("acceleration_kink", "angular_acceleration_kink")

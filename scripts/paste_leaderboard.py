@@ -1,11 +1,11 @@
 """Paste a ``sgc benchmark`` leaderboard into a markdown document, between markers.
 
-The README and docs/agents.md carry the leaderboard that ``sgc benchmark`` wrote, verbatim
+docs/results.md carries the leaderboards that ``sgc benchmark`` wrote, verbatim
 (its title dropped and its env headings demoted to ``###``), between the lines
 ``<!-- leaderboard:begin -->`` and ``<!-- leaderboard:end -->``, so a rerun of the benchmark
 updates them with one command::
 
-    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md docs/agents.md
+    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md docs/results.md
 
 ``--marker NAME`` pastes between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` instead, so
 one document can carry several leaderboards (the equal wall-clock one is ``budget-leaderboard``).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 21's equal wall-clock rows (docs/agents.md, "Equal wall-clock budgets"): every budget
+# The equal wall-clock leaderboard (docs/results.md; budgets explained in docs/agents.md): every budget
 # recipe of benchmarks/recipes.yml x 10 training seeds, one run per core (--workers 2 on the
 # 2-core machine; torch uses one thread per run). Resumable: rerun the same command and the
 # finished runs are skipped; with --report-only it runs nothing and writes the leaderboard
@@ -13,7 +13,7 @@ OUT=${OUT:-runs/benchmark/budget}
 SEEDS=${SEEDS:-10}
 WORKERS=${WORKERS:-2}
 SGC=${SGC:-.venv/bin/sgc}
-# keep in step with the budget recipes of benchmarks/recipes.yml (tests/test_budget.py checks)
+# keep in step with the budget recipes of benchmarks/recipes.yml (tests/baselines/agents/test_budget.py checks)
 ROWS=ppo-rod300-300s,sac-300s,td3-300s,ppo-raw-300s,bc-dagger-300s
 ROWS=$ROWS,ppo-point500k-120s,ppo-raw-120s,sac-120s,td3-120s,her-time-120s,bc-dagger-120s
 if [[ " $* " != *" --report-only "* ]]; then

@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from baselines.benchmark.manifest import held_out_result, steps_trained
+from baselines.zoo.manifest import held_out_result, steps_trained
 
 
 def _benchmark_score(run: Path, episodes: int, seed: int) -> dict[str, Any]:

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Create .venv (if missing) and install the project with its rl, ray, dev and minari extras
+# Create .venv (if missing) and install the project with its rl, ray, dev, minari and docs extras
 # (the benchmark tests start a real local Ray instance), at the tested versions of
 # constraints.txt (pyproject.toml keeps ranges for other environments).
 # torch is pinned to 2.13.0: the only build that installs here without gigabytes of CUDA wheels.
@@ -10,7 +10,7 @@ step "1/3 virtual environment .venv ($(python3 --version))"
 python3 -m venv .venv
 step "2/3 pip itself (the version the set-up was last tested with)"
 .venv/bin/python -m pip install --progress-bar on "pip==26.3"
-step "3/3 the project and its extras rl, ray, dev, minari (pinned by constraints.txt; a few minutes)"
+step "3/3 the project and its extras rl, ray, dev, minari, docs (pinned by constraints.txt; a few minutes)"
 .venv/bin/python -m pip install --progress-bar on -c constraints.txt \
-    "torch==2.13.0" -e ".[rl,ray,dev,minari]"
+    "torch==2.13.0" -e ".[rl,ray,dev,minari,docs]"
 step "done: run commands as .venv/bin/sgc, .venv/bin/python (or: source .venv/bin/activate)"

@@ -13,7 +13,7 @@ or, for a model already in the folder whose run is gone, the facts by hand::
 
 Either way the model is scored with the harness on held-out seeds, the entry replaces
 any entry for the same file, and the model card is written beside the model
-(``baselines/model_cards.py``; ``--card-episodes 0`` skips it, ``sgc card STEM`` redoes it).
+(``baselines/zoo/cards.py``; ``--card-episodes 0`` skips it, ``sgc card STEM`` redoes it).
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from baselines.benchmark.manifest import CHECKPOINTS, held_out_result, ship_model, write_entry
-from baselines.model_cards import write_model_card
+from baselines.zoo.cards import write_model_card
+from baselines.zoo.manifest import CHECKPOINTS, held_out_result, ship_model, write_entry
 
 
 def main() -> None:

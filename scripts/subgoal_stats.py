@@ -1,4 +1,5 @@
-"""How the smooth rule splits the courses (baselines/smooth_table.py) and what its table costs.
+"""How the smooth rule splits the courses (baselines/controllers/smooth_table.py) and what its table
+costs.
 
 On the paper's three-rod scene and held-out random rod scenes: the sub-course lengths per
 track kind (ticks between two sub-goals; a one-tick sub-course is the reference's next
@@ -17,8 +18,8 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the envs)
-from baselines.smooth_table import smooth_table
-from baselines.vector import base_env
+from baselines.common.sub_envs import base_env
+from baselines.controllers.smooth_table import smooth_table
 from sgc_env.defaults import EVAL_SEED
 
 

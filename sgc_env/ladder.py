@@ -2,7 +2,7 @@
 
 Spaces and body counts come from ``gym.make``, goal counts from the fixed scenario or the
 random family's config, so the tables in ``docs/environments.md`` and ``README.md`` cannot
-drift from the code: ``python -m sgc_env.ladder`` prints them and ``tests/test_ladder.py``
+drift from the code: ``python -m sgc_env.ladder`` prints them and ``tests/sgc_env/test_ladder.py``
 checks that the docs hold exactly what it prints.
 """
 

@@ -50,6 +50,6 @@ def make_env(request: pytest.FixtureRequest):  # type: ignore[no-untyped-def]
     with this runs on both (tests/one_or_many.py)."""
     if request.param == "single":
         return gym.make
-    from one_or_many import BatchOfOne
+    from tests.one_or_many import BatchOfOne
 
     return BatchOfOne

@@ -13,13 +13,13 @@ import pytest
 
 import sgc_env
 from baselines.agents.hyperparams import load_hyperparams
-from baselines.policies import make_policy
-from baselines.shipped import (
+from baselines.common.shipped import (
     hyperparams_file,
     resolve_policy_spec,
     shipped_files,
     shipped_models,
 )
+from baselines.policies import make_policy
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -17,7 +17,7 @@ from typing import Any
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.on_policy_algorithm import OnPolicyAlgorithm
 
-__all__ = ["TimeBudgetCallback", "check_time_budget", "steps_learned"]
+__all__ = ["TimeBudgetCallback", "check_time_budget", "steps_learned", "whole_rollouts"]
 
 
 def check_time_budget(value: Any, where: str = "time_budget_s") -> float | None:
@@ -30,6 +30,14 @@ def check_time_budget(value: Any, where: str = "time_budget_s") -> float | None:
     if not math.isfinite(seconds) or seconds <= 0:
         raise ValueError(f"{where}: expected a finite number of seconds > 0, got {value!r}")
     return seconds
+
+
+def whole_rollouts(timesteps: int, algo: str, hp: Any) -> int:
+    """``timesteps`` rounded up to what SB3 really trains with hyperparameters ``hp``
+    (:class:`~baselines.agents.hyperparams.Hyperparams`): PPO collects whole rollouts of
+    ``n_steps`` per env, the off-policy algorithms one step per env at a time."""
+    chunk = hp.n_envs * (int(hp.algo_kwargs.get("n_steps", 2048)) if algo == "ppo" else 1)
+    return -(-timesteps // chunk) * chunk
 
 
 def steps_learned(model: Any, stopped: bool) -> int | None:

@@ -3,7 +3,7 @@
 SB3's ``EvalCallback`` measures mean return, which for this task says little about what the
 benchmark grades (goals met within tolerance, punctuality, smoothness). This callback follows
 its pattern (every ``eval_freq`` env steps, held-out seeds, keep the best model) but runs
-:func:`baselines.evaluation.evaluate` on the current model instead.
+:func:`baselines.evaluation.harness.evaluate` on the current model instead.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback
 
-from baselines.normalization import save_statistics
+from baselines.models.normalization import save_statistics
 from baselines.policies import NormalizedPolicy
 from sgc_env.defaults import EVAL_SEED
 
@@ -113,7 +113,7 @@ class HarnessEvalCallback(BaseCallback):
 
     def evaluate_now(self) -> dict[str, Any]:
         """Run the harness once and record the result (also used after training)."""
-        from baselines.evaluation import evaluate
+        from baselines.evaluation.harness import evaluate
 
         train_time = self.train_time_s()
         started, cpu_started = time.perf_counter(), time.process_time()
@@ -201,7 +201,8 @@ class FreezeActorCallback(BaseCallback):
 
 class StatisticsCheckpointCallback(CheckpointCallback):
     """SB3's ``CheckpointCallback`` with the ``VecNormalize`` statistics in JSON
-    (``<prefix>_vecnormalize_<N>_steps.json``, :mod:`baselines.normalization`), not a pickle."""
+    (``<prefix>_vecnormalize_<N>_steps.json``, :mod:`baselines.models.normalization`), not a
+    pickle."""
 
     def __init__(self, save_freq: int, save_path: str, name_prefix: str = "rl_model",
                  save_vecnormalize: bool = False) -> None:  # fmt: skip

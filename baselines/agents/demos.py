@@ -33,8 +33,11 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.agents.pushes import Pushes, apply_random_push, push_rng
-from baselines.atomic_files import write_atomic
+from baselines.common.atomic_files import write_atomic
+from baselines.common.bounded_npz import limit_rows, npz_shapes
+from baselines.common.env_kwargs import check_kwarg_values
 from sgc_env import check_env_id
+from sgc_env.scenario.bounded import escaped, load_json
 
 __all__ = ["FORMAT_VERSION", "Demonstrations", "load_demos", "record_demos"]
 
@@ -99,40 +102,58 @@ class Demonstrations:
         )
 
 
+_STEP_ARRAYS = ("observations", "actions", "rewards", "terminations", "truncations",
+                "episode_starts")  # fmt: skip
+
+
 def load_demos(path: str | Path) -> Demonstrations:
-    """Read a file written by :meth:`Demonstrations.save` (never unpickling: a malformed or
-    hostile file is a ValueError naming it)."""
+    """Read a file written by :meth:`Demonstrations.save` (never unpickling; every array sized
+    from its header before it is read: a malformed or hostile file is a ValueError naming it)."""
     path = Path(path)
     if not path.is_file():
-        raise ValueError(f"demos: no such file {path}")
+        raise ValueError(f"demos: no such file {escaped(path)}")
+    where = f"demos: {escaped(path)}"
+    shapes = npz_shapes(path, where)
+    limit_rows(shapes, where)
     try:
-        return _read_demos(path)
-    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        return _read_demos(path, where)
+    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile,
+            MemoryError) as exc:  # fmt: skip
         if str(exc).startswith("demos:"):
             raise
-        raise ValueError(f"demos: {path} is not a demonstrations file from `sgc demos` "
-                         f"({type(exc).__name__}: {exc})") from None  # fmt: skip
+        raise ValueError(f"{where} is not a demonstrations file from `sgc demos` "
+                         f"({type(exc).__name__}: {escaped(exc)})") from None  # fmt: skip
 
 
-def _read_demos(path: Path) -> Demonstrations:
+def _read_demos(path: Path, where: str) -> Demonstrations:
     with np.load(path, allow_pickle=False) as data:
         version = int(data["format_version"]) if "format_version" in data else None
         if version != FORMAT_VERSION:
-            raise ValueError(
-                f"demos: {path} has format_version {version}, expected {FORMAT_VERSION}"
-            )
-        return Demonstrations(
-            observations=data["observations"],
-            actions=data["actions"],
-            rewards=data["rewards"],
-            terminations=data["terminations"],
-            truncations=data["truncations"],
-            episode_starts=data["episode_starts"],
-            seeds=data["seeds"],
-            env_id=str(data["env_id"]),
-            env_kwargs=json.loads(str(data["env_kwargs"])),
-            pushes=Pushes(**json.loads(str(data["pushes"]))) if "pushes" in data else Pushes(),
-        )
+            raise ValueError(f"{where} has format_version {version}, expected {FORMAT_VERSION}")
+        steps = {key: data[key] for key in _STEP_ARRAYS}
+        env_id = check_env_id(str(data["env_id"]), f"{where}: env_id")
+        env_kwargs = load_json(str(data["env_kwargs"]), f"{where}: env_kwargs")
+        pushes = load_json(str(data["pushes"]), f"{where}: pushes") if "pushes" in data else {}
+        seeds = data["seeds"]
+    _check_steps(steps, where)
+    if not isinstance(env_kwargs, dict) or not isinstance(pushes, dict):
+        raise ValueError(f"{where}: env_kwargs and pushes must be JSON objects")
+    check_kwarg_values(env_kwargs, f"{where}: env_kwargs")
+    return Demonstrations(**steps, seeds=seeds, env_id=env_id, env_kwargs=env_kwargs,
+                          pushes=Pushes(**pushes))  # fmt: skip
+
+
+def _check_steps(steps: dict[str, np.ndarray], where: str) -> None:
+    """One row per step in every array, 2-D finite observations and actions in [-1, 1]."""
+    rows = {key: value.shape[0] if value.ndim else -1 for key, value in steps.items()}
+    if len(set(rows.values())) != 1:
+        raise ValueError(f"{where}: the step arrays differ in length ({rows})")
+    obs, actions = steps["observations"], steps["actions"]
+    if obs.ndim != 2 or actions.ndim != 2 or obs.dtype.kind != "f" or actions.dtype.kind != "f":
+        raise ValueError(f"{where}: observations and actions must be 2-D float arrays, got "
+                         f"{obs.dtype}{obs.shape} and {actions.dtype}{actions.shape}")  # fmt: skip
+    if not (np.all(np.isfinite(obs)) and np.all(np.abs(actions) <= 1.0)):
+        raise ValueError(f"{where}: observations must be finite and actions in [-1, 1]")
 
 
 def record_demos(

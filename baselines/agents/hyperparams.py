@@ -10,15 +10,16 @@ from __future__ import annotations
 
 import ast
 import inspect
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from baselines.agents.features import ACTIVATIONS
-from baselines.shipped import hyperparams_file
-from baselines.value_types import describe, matches
+from baselines.common.network_caps import check_policy_kwargs
+from baselines.common.shipped import hyperparams_file
+from baselines.common.value_types import describe, matches
+from baselines.models.features import ACTIVATIONS
+from sgc_env.scenario.bounded import check_count, escaped, load_yaml, read_text
 
 __all__ = [
     "ALGORITHMS",
@@ -64,24 +65,25 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
     if short in ACTIVATIONS:
         return getattr(nn, short)
     if short == "StandardizeObservation":
-        from baselines.agents.features import StandardizeObservation
+        from baselines.models.features import StandardizeObservation
 
         return StandardizeObservation
     if short == "ScheduleFeatures":
-        from baselines.agents.schedule_features import ScheduleFeatures
+        from baselines.models.schedule_features import ScheduleFeatures
 
         return ScheduleFeatures
     if short == "HerReplayBuffer":
         from stable_baselines3 import HerReplayBuffer
 
         return HerReplayBuffer
-    raise ValueError(f"{field_name}: name {dotted!r} is not allowed (activations: {ACTIVATIONS})")
+    raise ValueError(f"{field_name}: name {escaped(repr(dotted))} is not allowed (activations: "
+                     f"{ACTIVATIONS})")  # fmt: skip
 
 
 def _policy_class(name: str) -> str | type:
     """SB3's policy aliases stay strings; ``PerBodyPolicy`` is this project's class."""
     if name == "PerBodyPolicy":
-        from baselines.agents.per_body import PerBodyPolicy
+        from baselines.models.per_body import PerBodyPolicy
 
         return PerBodyPolicy
     return name
@@ -117,18 +119,21 @@ def _literal(node: ast.AST, field_name: str) -> Any:
     name = _dotted(node)
     if name is not None:
         return _resolve_name(name, field_name)
-    raise ValueError(f"{field_name}: unsupported expression {ast.unparse(node)!r}")
+    raise ValueError(f"{field_name}: unsupported expression {escaped(repr(ast.unparse(node)))}")
 
 
 def parse_kwargs_string(text: str, field_name: str = "policy_kwargs") -> dict[str, Any]:
-    """Parse ``"dict(net_arch=[64, 64], activation_fn=nn.Tanh)"`` without ``eval``."""
+    """Parse ``"dict(net_arch=[64, 64], activation_fn=nn.Tanh)"`` without ``eval`` (deep or
+    huge text is a ValueError too, never a RecursionError or MemoryError)."""
     try:
         tree = ast.parse(text.strip(), mode="eval")
+        value = _literal(tree.body, field_name)
     except SyntaxError as exc:
-        raise ValueError(f"{field_name}: cannot parse {text!r}: {exc.msg}") from exc
-    value = _literal(tree.body, field_name)
+        raise ValueError(f"{field_name}: cannot parse {escaped(repr(text))}: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ValueError(f"{field_name}: nested too deeply to read") from None
     if not isinstance(value, dict):
-        raise ValueError(f"{field_name}: expected dict(...) or {{...}}, got {text!r}")
+        raise ValueError(f"{field_name}: expected dict(...) or {{...}}, got {escaped(repr(text))}")
     return value
 
 
@@ -144,12 +149,17 @@ def linear_schedule(initial: float):
 def _learning_rate(value: Any) -> Any:
     try:
         if isinstance(value, str) and value.startswith("lin_"):
-            return linear_schedule(float(value[4:]))
-        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
-            return float(value)
-    except ValueError:
+            rate = float(value[4:])
+            if math.isfinite(rate) and rate > 0:
+                return linear_schedule(rate)
+        elif isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            rate = float(value)
+            if math.isfinite(rate) and rate > 0:
+                return rate
+    except (ValueError, OverflowError):
         pass
-    raise ValueError(f"learning_rate: expected a number or lin_<number>, got {value!r}")
+    raise ValueError(f"learning_rate: expected a finite number > 0 or lin_<number>, got "
+                     f"{escaped(repr(value))}")  # fmt: skip
 
 
 _NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward")
@@ -191,15 +201,14 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
     algo_cls = algorithm_class(algo)
     path = Path(directory) / f"{algo}.yml" if directory else hyperparams_file(algo)
     if not path.is_file():
-        raise ValueError(f"algo: no hyperparameter file {path}")
-    try:
-        table = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ValueError(f"{path}: bad YAML: {' '.join(str(exc).split())}") from None
+        raise ValueError(f"algo: no hyperparameter file {escaped(path)}")
+    text = read_text(path, "hyperparameters") if isinstance(path, Path) else path.read_text()
+    table = load_yaml(text, f"hyperparameters {escaped(path)}")
     if not isinstance(table, dict):
         raise ValueError(f"{path}: expected a mapping of env id -> hyperparameters")
     if env_id not in table:
-        raise ValueError(f"env: {path} has no hyperparameters for {env_id!r} (has {sorted(table)})")
+        raise ValueError(f"env: {path} has no hyperparameters for {env_id!r} (has "
+                         f"{escaped(sorted(map(str, table)))})")  # fmt: skip
     entry = table[env_id]
     if not isinstance(entry, dict):
         raise ValueError(f"{path}: entry {env_id!r} must be a mapping")
@@ -215,19 +224,32 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         if key not in allowed:
             raise ValueError(f"{path}: {env_id}: unknown field {key!r} for {algo_cls.__name__}")
         if key in _STRING_KWARGS and isinstance(value, str):
-            value = parse_kwargs_string(value, key)
+            try:
+                value = parse_kwargs_string(value, key)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {env_id}: {exc}") from None
+        if key == "policy_kwargs":
+            check_policy_kwargs(value, f"{path}: {env_id}: policy_kwargs")
         elif key == "learning_rate":
             try:
                 value = _learning_rate(value)
             except ValueError as exc:
                 raise ValueError(f"{path}: {env_id}: {exc}") from None
         elif key == "replay_buffer_class" and isinstance(value, str):
-            value = _resolve_name(value, key)
+            try:
+                value = _resolve_name(value, key)
+            except ValueError as exc:
+                raise ValueError(f"{path}: {env_id}: {exc}") from None
         if matches(value, parameters[key].annotation) is False:
             hint = describe(parameters[key].annotation)
             raise ValueError(f"{path}: {env_id}: {key} must be {hint}, got {value!r}")
         kwargs[key] = value
-    normalize, normalize_kwargs = _normalize(entry.get("normalize", False), f"{path}: {env_id}")
+    try:
+        normalize, normalize_kwargs = _normalize(entry.get("normalize", False), f"{path}: {env_id}")
+    except ValueError as exc:
+        message = str(exc)
+        raise ValueError(message if message.startswith(str(path)) else f"{path}: {env_id}: "
+                         f"{message}") from None  # fmt: skip
     noise_type = entry.get("noise_type")
     if noise_type not in (None, "normal"):
         raise ValueError(f"{path}: {env_id}: noise_type must be 'normal', got {noise_type!r}")
@@ -247,6 +269,7 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         raise ValueError(f"{path}: {env_id}: policy must be a name such as MlpPolicy")
     if n_envs < 1:
         raise ValueError(f"{path}: {env_id}: n_envs must be >= 1, got {n_envs}")
+    check_count(n_envs, "n_envs", f"{path}: {env_id}: n_envs")
     return Hyperparams(
         env_id=env_id,
         algo=algo,

@@ -5,7 +5,7 @@ Two choices keep the dataset exact and loadable without changing the env's contr
 - **Actions are stored as the float64 the expert gives the env.** The env's action space is a
   float32 Box, but the env uses whatever precision it is handed; rounding the expert's action
   to float32 moves a thin rod's orientation at a goal by up to ~1e-9 rad (see
-  :meth:`~baselines.env_model.EnvModel.action_from_wrenches`). The dataset declares a float64
+  :meth:`~baselines.common.env_model.EnvModel.action_from_wrenches`). The dataset declares a float64
   Box with the env's bounds, so its actions belong to its space, and replaying them through
   ``dataset.recover_environment()`` reproduces the recorded observations bit for bit.
 - **Infos have one fixed shape per step** (:func:`fixed_info`): the env reports

@@ -18,9 +18,9 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.agents.hyperparams import ALGORITHMS, algorithm_class
+from baselines.agents.hyperparams import ALGORITHMS, Hyperparams, algorithm_class
 from baselines.agents.pushes import Pushes
-from baselines.env_kwargs import check_env_kwargs
+from baselines.common.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
 
 __all__ = [
@@ -29,6 +29,7 @@ __all__ = [
     "TrainResult",
     "algorithm_class",
     "load_model",
+    "record_run_folder",
     "train",
 ]
 
@@ -84,7 +85,7 @@ class TrainResult:
 
 
 def _make_env(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], vec: str | None):
-    from baselines.batched import make_sgc_vec
+    from baselines.agents.sb3_vec_env import make_sgc_vec
 
     return make_sgc_vec(env_id, n_envs, seed, env_kwargs, vec)
 
@@ -141,8 +142,11 @@ def _jsonable(value: Any) -> Any:
     return getattr(value, "__name__", repr(value))
 
 
-def train(cfg: TrainConfig) -> TrainResult:
-    """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`)."""
+def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
+    """Build, optionally clone from demos, train and save one model (see :class:`TrainConfig`).
+
+    ``hp``: the hyperparameters of ``cfg`` when the caller has parsed them already (they are
+    parsed once per run); None reads them from ``cfg.hyperparams_dir``."""
     import torch as th
     from stable_baselines3.common.callbacks import BaseCallback, CallbackList
     from stable_baselines3.common.utils import set_random_seed
@@ -155,12 +159,13 @@ def train(cfg: TrainConfig) -> TrainResult:
         StatisticsCheckpointCallback,
     )
     from baselines.agents.hyperparams import load_hyperparams
-    from baselines.normalization import save_statistics
+    from baselines.models.normalization import save_statistics
 
     _validate(cfg)
     started = time.perf_counter()
     th.set_num_threads(1)
-    hp = load_hyperparams(cfg.algo, cfg.env_id, cfg.hyperparams_dir)
+    if hp is None:
+        hp = load_hyperparams(cfg.algo, cfg.env_id, cfg.hyperparams_dir)
     total = hp.n_timesteps if cfg.timesteps is None else int(cfg.timesteps)
     set_random_seed(cfg.seed)
     env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs, cfg.vec)
@@ -172,7 +177,7 @@ def train(cfg: TrainConfig) -> TrainResult:
         env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
     kwargs = dict(hp.algo_kwargs)
     if cfg.init == "bc":
-        from baselines.agents.features import StandardizeObservation
+        from baselines.models.features import StandardizeObservation
 
         policy_kwargs = dict(kwargs.get("policy_kwargs") or {})
         policy_kwargs.setdefault("features_extractor_class", StandardizeObservation)
@@ -280,19 +285,29 @@ def train(cfg: TrainConfig) -> TrainResult:
     return result
 
 
+def record_run_folder(written: Path, out: Path) -> None:
+    """Let ``config.json``, written in folder ``written``, name the run folder ``out`` (a
+    run staged elsewhere and moved in)."""
+    config = written / "config.json"
+    data = json.loads(config.read_text())
+    data["train_config"]["out"] = str(out)
+    config.write_text(json.dumps(data, indent=1))
+
+
 def _clone(model: Any, cfg: TrainConfig, deadline: float | None = None) -> dict[str, Any]:
     """Behaviour-clone (and optionally DAgger) the new model's actor from ``cfg.demos``;
     no DAgger round starts after ``deadline`` (a ``time.perf_counter()`` reading)."""
     from baselines.agents.bc import behaviour_clone, dagger, imitation_loss
     from baselines.agents.demos import load_demos
-    from baselines.agents.features import set_statistics
+    from baselines.models.features import set_statistics
 
     demos = load_demos(cfg.demos)  # type: ignore[arg-type]
     if demos.env_id != cfg.env_id:
-        raise ValueError(f"demos: recorded on {demos.env_id!r}, training on {cfg.env_id!r}")
+        raise ValueError(f"demos: {cfg.demos}: recorded on {demos.env_id!r}, training on "
+                         f"{cfg.env_id!r}")  # fmt: skip
     if demos.observations.shape[1:] != model.observation_space.shape:
         raise ValueError(
-            f"demos: observations of shape {demos.observations.shape[1:]} do not fit "
+            f"demos: {cfg.demos}: observations of shape {demos.observations.shape[1:]} do not fit "
             f"{cfg.env_id}'s {model.observation_space.shape}; re-record them with `sgc demos`"
         )
     set_statistics(model.policy, demos.observations)
@@ -317,7 +332,7 @@ def load_model(
     path: str | Path, env: Any | None = None, device: str = "cpu", trust_model: bool = False
 ) -> Any:
     """Load an SB3 ``.zip`` whatever algorithm wrote it, without unpickling unless
-    ``trust_model`` (:mod:`baselines.model_files`; safe loading needs ``env``)."""
-    from baselines.model_files import load_sb3_model
+    ``trust_model`` (:mod:`baselines.models.model_files`; safe loading needs ``env``)."""
+    from baselines.models.model_files import load_sb3_model
 
     return load_sb3_model(path, env=env, device=device, trust_model=trust_model)

@@ -15,10 +15,13 @@ import tempfile
 import time
 import traceback
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from baselines.atomic_files import write_atomic
 from baselines.benchmark.grid import RunSpec, train_command
+from baselines.common.atomic_files import write_atomic
+
+if TYPE_CHECKING:
+    from baselines.agents.hyperparams import Hyperparams
 
 __all__ = ["FAILED_FILE", "RESULT_FILE", "execute_run", "write_outcome"]
 
@@ -28,35 +31,31 @@ FAILED_FILE = "failed.json"
 _SKIP = ("checkpoints",)
 
 
-def _resolved_eval_freq(spec: RunSpec) -> int:
+def _resolved_eval_freq(spec: RunSpec, hp: Hyperparams) -> int:
     """``eval_freq`` 0 means four learning-curve points over the steps the run will take."""
     if spec.eval_freq:
         return spec.eval_freq
-    from baselines.agents.hyperparams import load_hyperparams
+    from baselines.agents.budget import whole_rollouts
 
-    hp = load_hyperparams(spec.recipe.algo, spec.env_id, spec.recipe.hyperparams)
     total = hp.n_timesteps if spec.recipe.timesteps is None else spec.recipe.timesteps
-    if spec.recipe.algo == "ppo":  # PPO learns in whole rollouts of n_steps x n_envs
-        rollout = int(hp.algo_kwargs.get("n_steps", 2048)) * hp.n_envs
-        total = -(-total // rollout) * rollout
-    return max(total // CURVE_POINTS, 1)
+    return max(whole_rollouts(total, spec.recipe.algo, hp) // CURVE_POINTS, 1)
 
 
 CURVE_POINTS = 4
 """Learning-curve points per run when ``--eval-freq`` is 0: over its steps, or its budget."""
 
 
-def _curve_schedule(spec: RunSpec) -> dict[str, Any]:
+def _curve_schedule(spec: RunSpec, hp: Hyperparams) -> dict[str, Any]:
     """``eval_freq`` (steps) or, for a run with a time budget and ``--eval-freq 0``,
     ``eval_every_s``: the same four points over the budget for every family."""
     budget = spec.recipe.time_budget_s
     if spec.eval_freq or budget is None:
-        return {"eval_freq": _resolved_eval_freq(spec)}
+        return {"eval_freq": _resolved_eval_freq(spec, hp)}
     return {"eval_freq": 0, "eval_every_s": budget / CURVE_POINTS}
 
 
 def _score(model: Path, spec: RunSpec) -> dict[str, Any]:
-    from baselines.evaluation import evaluate, json_ready
+    from baselines.evaluation.harness import evaluate, json_ready
 
     result = evaluate(
         str(model), spec.env_id, spec.eval_episodes, spec.test_seed,
@@ -75,6 +74,7 @@ def _pack(folder: Path) -> dict[str, bytes]:
 
 def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
     """Train and score one run; never raises (a failure is returned with its traceback)."""
+    from baselines.agents.hyperparams import load_hyperparams
     from baselines.agents.train import TrainConfig, train
 
     spec = RunSpec.from_dict(spec_dict)
@@ -83,11 +83,12 @@ def execute_run(spec_dict: dict[str, Any]) -> dict[str, Any]:
     try:
         with tempfile.TemporaryDirectory(prefix="sgc-bench-") as tmp:
             out = Path(tmp)
+            hp = load_hyperparams(spec.recipe.algo, spec.env_id, spec.recipe.hyperparams)
             options = spec.train_options(out="RUN_DIR")
-            options.update(_curve_schedule(spec))
+            options.update(_curve_schedule(spec, hp))
             command = train_command(options)
             options["out"] = str(out)
-            result = train(TrainConfig(**options, command=command))
+            result = train(TrainConfig(**options, command=command), hp)
             best = out / "best_model.zip"
             final = Path(result.model_path or out / "final_model.zip")
             scores = {"final": _score(final, spec)}

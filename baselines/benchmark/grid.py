@@ -19,9 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from baselines.value_types import describe, matches
+from baselines.common.value_types import describe, matches
+from sgc_env.scenario.bounded import escaped, load_yaml, read_text
 
 __all__ = [
     "EVAL_SEED",
@@ -192,6 +191,7 @@ def _check_name(name: Any, where: str) -> str:
 def _recipe(entry: Any, where: str) -> Recipe:
     from baselines.agents.budget import check_time_budget
     from baselines.agents.train import ALGORITHMS
+    from baselines.common.env_kwargs import check_kwarg_values
 
     if not isinstance(entry, Mapping):
         raise ValueError(f"{where}: expected a mapping, got {type(entry).__name__}")
@@ -210,6 +210,7 @@ def _recipe(entry: Any, where: str) -> Recipe:
     train = entry.get("train") or {}
     if not isinstance(env_kwargs, Mapping) or not isinstance(train, Mapping):
         raise ValueError(f"{where}: env_kwargs and train must be mappings")
+    check_kwarg_values(env_kwargs, f"{where}: env_kwargs")
     allowed = set(_train_fields()) - _OWNED
     bad = set(train) - allowed
     if bad:
@@ -239,11 +240,9 @@ def load_recipes(path: str | Path) -> list[Recipe]:
     """
     file = Path(path)
     if not file.is_file():
-        raise ValueError(f"--recipes: no file {str(path)!r}")
-    try:
-        data = yaml.safe_load(file.read_text())
-    except yaml.YAMLError as exc:
-        raise ValueError(f"--recipes: {file}: bad YAML: {' '.join(str(exc).split())}") from None
+        raise ValueError(f"--recipes: no file {escaped(repr(str(path)))}")
+    where = f"--recipes: {escaped(file)}"
+    data = load_yaml(read_text(file, "--recipes:"), where)
     entries = data.get("recipes") if isinstance(data, Mapping) else None
     if not isinstance(entries, list) or not entries:
         raise ValueError(f"--recipes: {file}: expected a non-empty list under 'recipes:'")
@@ -292,7 +291,7 @@ def build_grid(
 ) -> list[RunSpec]:
     """Every (recipe, env, seed), after checking the arguments (``ValueError`` naming them)."""
     from baselines.agents.hyperparams import load_hyperparams
-    from baselines.env_kwargs import check_env_kwargs
+    from baselines.common.env_kwargs import check_env_kwargs
     from sgc_env import check_env_id
 
     if not recipes:

@@ -20,13 +20,13 @@ from typing import Any
 
 import numpy as np
 
-from baselines.atomic_files import write_atomic
 from baselines.benchmark.aggregate import (
     CONFIDENCE,
     CURVE_AXES,
     learning_curve,
     performance_profile,
 )
+from baselines.common.atomic_files import write_atomic
 
 __all__ = ["format_ci", "markdown", "write_report"]
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import math
 import os
 import shutil
@@ -24,6 +23,7 @@ from typing import Any
 __all__ = [
     "UsageError",
     "add_trust_argument",
+    "error_exit",
     "bounded_int",
     "env_kwargs",
     "existing_dir",
@@ -43,6 +43,16 @@ __all__ = [
 
 class UsageError(ValueError):
     """A command-line argument is wrong; ``sgc`` prints the message and exits 2."""
+
+
+def error_exit(command: str, exc: BaseException | str) -> int:
+    """Print ``sgc COMMAND: error: MESSAGE`` on one line of stderr and return 2. The message
+    is escaped: text it quotes from a file (a newline, a terminal escape) cannot start a line
+    of its own or forge one."""
+    from sgc_env.scenario.bounded import escaped
+
+    print(f"sgc {command}: error: {escaped(exc, 2000)}", file=sys.stderr)
+    return 2
 
 
 def _number(kind: Callable[[str], Any], text: str) -> Any:
@@ -161,21 +171,38 @@ def known_env_id(env_id: str) -> str:
 
 
 def env_kwargs(text: str) -> dict[str, Any]:
-    """A JSON object (keyword arguments for ``gym.make``)."""
+    """A JSON object (keyword arguments for ``gym.make``), read within the caps."""
+    from sgc_env.scenario.bounded import FileLimitError, escaped, load_json
+
     try:
-        value = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise argparse.ArgumentTypeError(f"not valid JSON ({exc.msg} at {exc.pos})") from None
+        value = load_json(text, "JSON")
+    except FileLimitError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("JSON: ")) from None
     if not isinstance(value, dict):
-        raise argparse.ArgumentTypeError(f"expected a JSON object, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a JSON object, got {escaped(repr(text))}")
     return value
 
 
+def _real_folder(out: Path, relative: Path) -> Path:
+    """``out / relative`` as a real folder: a link met on the way (to a folder elsewhere,
+    or dangling) is replaced by a folder, never written through."""
+    out.mkdir(parents=True, exist_ok=True)
+    folder = out
+    for part in relative.parts:
+        folder = folder / part
+        if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+            folder.unlink()
+        folder.mkdir(exist_ok=True)
+    return folder
+
+
 def _move_files(stage: Path, out: Path, folder: str = "") -> None:
+    """Move the staged files into ``out``; ``os.replace`` puts each file in place of a file
+    or a link of its name (it never writes through a link), and :func:`_real_folder` does
+    the same for the folders on the way."""
     for src in sorted(p for p in (stage / folder).rglob("*") if p.is_file()):
-        dest = out / src.relative_to(stage)
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(src, dest)
+        relative = src.relative_to(stage)
+        os.replace(src, _real_folder(out, relative.parent) / relative.name)
 
 
 @contextlib.contextmanager
@@ -199,7 +226,8 @@ def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[
 
 
 def add_trust_argument(parser: argparse.ArgumentParser) -> None:
-    """``--trust-model``: load model files with SB3's unpickling (see baselines.model_files)."""
+    """``--trust-model``: load model files with SB3's unpickling (see
+    baselines.models.model_files)."""
     parser.add_argument(
         "--trust-model", action="store_true",
         help="unpickle model files (.zip fields, .vecnormalize.pkl) as SB3 does: a file can "
@@ -212,7 +240,7 @@ def trust_model(args: argparse.Namespace, command: str) -> bool:
     """``args.trust_model``, printing the risk to stderr when it is set."""
     trust = bool(getattr(args, "trust_model", False))
     if trust:
-        from baselines.model_files import TRUST_WARNING
+        from baselines.models.model_files import TRUST_WARNING
 
         print(f"sgc {command}: warning: {TRUST_WARNING}", file=sys.stderr)
     return trust

@@ -11,7 +11,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 
-from baselines.cli.checks import UsageError
+from baselines.cli.checks import UsageError, error_exit
 from baselines.cli.console import DefaultsHelpFormatter
 
 __all__ = ["COMMANDS", "build_parser", "main"]
@@ -52,8 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args._module.run(args) or 0)
     except UsageError as exc:  # a bad argument found before any work; real bugs still raise
-        print(f"sgc {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit(args.command, exc)
 
 
 if __name__ == "__main__":

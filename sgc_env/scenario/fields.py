@@ -9,19 +9,22 @@ PyBullet simulates faithfully, or make the work of loading and running unbounded
 from __future__ import annotations
 
 import math
+import reprlib
 from collections.abc import Mapping, Sequence
 from collections.abc import Set as AbstractSet
 from typing import Any
 
 import numpy as np
 
+from sgc_env.scenario.bounded import FileLimitError, check_count, escaped
+from sgc_env.scenario.caps import cap
 from sgc_env.scenario.model import Quat, ScenarioError
 
 __all__ = [
     "FIELDS", "LIMITS", "MAX_EPISODE_STEPS", "MAX_GOALS", "MAX_HELIX_TURNS", "MAX_PATH_SAMPLES",
-    "MAX_WAYPOINTS", "PATH_GOAL_KEYS", "SHAPES", "TIME_GRID_MODES", "WORKSPACE_LIMIT", "check_keys",
-    "as_float", "coords_in_range", "fail", "field_keys", "in_range", "limit_text", "mapping",
-    "norm_in_range", "number", "quaternion", "require", "show", "vector",
+    "MAX_WAYPOINTS", "PATH_GOAL_KEYS", "SHAPES", "TIME_GRID_MODES", "WORKSPACE_LIMIT", "check_cap",
+    "check_keys", "as_float", "coords_in_range", "fail", "field_keys", "in_range", "limit_text",
+    "mapping", "norm_in_range", "number", "quaternion", "require", "show", "vector",
 ]  # fmt: skip
 
 SHAPES: dict[str, tuple[str, ...]] = {
@@ -32,10 +35,10 @@ SHAPES: dict[str, tuple[str, ...]] = {
 TIME_GRID_MODES = ("reject", "snap")
 WORKSPACE_LIMIT = 1e4  # keeps every observation entry inside the env's +-1e5 bounds
 MAX_EPISODE_STEPS = 100_000  # control ticks; the harness's default episode cap
-MAX_PATH_SAMPLES = 1_000
-MAX_GOALS = 10_000  # per body
-MAX_WAYPOINTS = 10_000  # per prop
-MAX_HELIX_TURNS = 1_000
+MAX_PATH_SAMPLES = cap("path_samples")
+MAX_GOALS = cap("goals")  # per scenario, after path goals expand
+MAX_WAYPOINTS = cap("prop_waypoints")  # per prop
+MAX_HELIX_TURNS = cap("helix_turns")
 
 FIELDS: dict[str, str] = {
     "name": "text",
@@ -168,12 +171,21 @@ def as_float(value: float | np.floating | np.integer, path: str) -> float:
         ) from None
 
 
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = _SHORT.maxother = 120
+_SHORT.maxlist = _SHORT.maxtuple = _SHORT.maxdict = 10
+
+
 def show(value: Any) -> str:
-    """``repr(value)``, but an integer of hundreds of digits as its size (Python refuses to
-    print integers of more than 4300 digits)."""
+    """``repr(value)`` cut short and escaped onto one line (a value from a file may be huge or
+    hold newlines and terminal escapes), and an integer of hundreds of digits as its size
+    (Python refuses to print integers of more than 4300 digits)."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**20:
         return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
-    return repr(value)
+    try:
+        return escaped(_SHORT.repr(value))
+    except ValueError:  # an integer of more than 4300 digits inside a list
+        return "a value too large to print"
 
 
 def quoted_hint(value: Any) -> str:
@@ -252,6 +264,15 @@ def norm_in_range(vec: Sequence[float], key: str, path: str) -> None:
     norm = math.sqrt(math.fsum(x * x for x in vec))
     if not math.isfinite(norm) or norm > LIMITS[key][1]:
         raise fail(path, f"magnitude {norm:.6g} of {tuple(vec)} is outside {limit_text(key)}")
+
+
+def check_cap(count: int, name: str, path: str) -> None:
+    """``count`` within cap ``name`` of :data:`~sgc_env.scenario.caps.CAPS`, else a
+    ScenarioError naming ``path``."""
+    try:
+        check_count(count, name, path)
+    except FileLimitError as exc:
+        raise ScenarioError(str(exc)) from None
 
 
 def coords_in_range(vec: Sequence[float], path: str) -> None:

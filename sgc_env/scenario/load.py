@@ -15,6 +15,7 @@ from typing import Any
 
 import yaml
 
+from sgc_env.scenario.bounded import FileLimitError, escaped, load_yaml, read_text
 from sgc_env.scenario.model import Scenario, ScenarioError
 from sgc_env.scenario.parse import scenario_from_dict
 from sgc_env.scenario.resolve import resolve_scenario
@@ -57,15 +58,12 @@ def builtin_scenarios() -> tuple[str, ...]:
 
 
 def read_yaml(text: str, name: str) -> Any:
-    """Plain data of a scenario's YAML text, or a ScenarioError naming ``name``."""
+    """Plain data of a scenario's YAML text within the size, nesting and value caps
+    (:mod:`sgc_env.scenario.bounded`), or a ScenarioError naming ``name``."""
     try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506 (a safe loader)
-    except yaml.YAMLError as exc:
-        raise ScenarioError(f"{name}: not valid YAML: {exc}") from None
-    except RecursionError:
-        raise ScenarioError(f"{name}: nested too deeply to read") from None
-    except ValueError as exc:  # e.g. an integer of more than 4300 digits
-        raise ScenarioError(f"{name}: not valid YAML: {exc}") from None
+        return load_yaml(text, escaped(name), _Loader)
+    except FileLimitError as exc:
+        raise ScenarioError(str(exc)) from None
 
 
 def builtin_data(name: str) -> Any:
@@ -80,38 +78,38 @@ def builtin_data(name: str) -> Any:
 
 
 def load_scenario(path_or_name: str | Path | Scenario) -> Scenario:
-    """Load, validate and resolve a scenario from a YAML path or a built-in name."""
+    """Load, validate and resolve a scenario from a YAML path or a built-in name; a fault in
+    a file is a ScenarioError that starts with the file and then names the field."""
     if isinstance(path_or_name, Scenario):
         return resolve_scenario(path_or_name)
     path = Path(path_or_name)
     if path.suffix in (".yaml", ".yml") and path.exists():
-        return scenario_from_yaml(_read_text(path), path.stem)
+        return scenario_from_yaml(_read_text(path), path.stem, where=f"scenario {escaped(path)}")
     name = str(path_or_name)
     return _resolved(builtin_data(name), name)
 
 
-def scenario_from_yaml(text: str, name: str = "scenario") -> Scenario:
-    """The resolved scenario written in YAML ``text``; any fault is a ScenarioError that names
-    ``name`` or the field."""
-    return _resolved(read_yaml(text, name), name)
+def scenario_from_yaml(text: str, name: str = "scenario", where: str | None = None) -> Scenario:
+    """The resolved scenario written in YAML ``text`` (``name``: its name unless it has one);
+    any fault is a ScenarioError that starts with ``where`` (default: ``name``)."""
+    return _resolved(read_yaml(text, where or name), name, where)
 
 
-def _resolved(data: Any, name: str) -> Scenario:
+def _resolved(data: Any, name: str, where: str | None = None) -> Scenario:
     try:
         return resolve_scenario(scenario_from_dict(data, name=name))
     except RecursionError:  # a YAML alias can make a list that contains itself
-        raise ScenarioError(f"{name}: nested too deeply to read") from None
+        raise ScenarioError(f"{where or escaped(name)}: nested too deeply to read") from None
+    except ScenarioError as exc:
+        if where is None:
+            raise
+        raise ScenarioError(f"{where}: {exc}") from None
 
 
 def _read_text(path: Path) -> str:
-    """The file's text, or a ScenarioError naming the file and what is wrong with it."""
+    """The file's text (size checked first), or a ScenarioError naming the file and what is
+    wrong with it."""
     try:
-        return path.read_text(encoding="utf-8")
-    except IsADirectoryError:
-        raise ScenarioError(f"{path}: is a directory, not a scenario file") from None
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(
-            f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason}); save it as UTF-8"
-        ) from None
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        return read_text(path, "scenario")
+    except FileLimitError as exc:
+        raise ScenarioError(str(exc)) from None

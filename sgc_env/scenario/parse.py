@@ -12,13 +12,13 @@ from typing import Any
 
 import numpy as np
 
+from sgc_env.scenario.bounded import escaped
 from sgc_env.scenario.curves import parametric_curve, path_goals
 from sgc_env.scenario.fields import (
-    MAX_GOALS,
     MAX_HELIX_TURNS,
     MAX_PATH_SAMPLES,
-    MAX_WAYPOINTS,
     PATH_GOAL_KEYS,
+    check_cap,
     check_keys,
     fail,
     field_keys,
@@ -29,7 +29,7 @@ from sgc_env.scenario.fields import (
     show,
     vector,
 )
-from sgc_env.scenario.model import Body, Goal, Prop, Scenario, ScenarioError
+from sgc_env.scenario.model import Body, Goal, Prop, Scenario
 
 __all__ = ["scenario_from_dict"]
 
@@ -42,8 +42,7 @@ _SCENARIO_KEYS = field_keys("")
 def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
     if not isinstance(raw, list):
         raise fail(path, f"expected a list of goals, got {type(raw).__name__}")
-    if len(raw) > MAX_GOALS:
-        raise fail(path, f"{len(raw)} goals; at most {MAX_GOALS} per body")
+    check_cap(len(raw), "goals", path)
     goals: list[Goal] = []
     for j, g in enumerate(raw):
         p = f"{path}[{j}]"
@@ -84,9 +83,44 @@ def _parse_goals(raw: Any, path: str) -> tuple[Goal, ...]:
     return tuple(goals)
 
 
+_PATH_PARAMS: dict[str, tuple[frozenset[str], frozenset[str]]] = {
+    "line": (frozenset({"start", "end"}), frozenset()),
+    "arc": (frozenset({"center", "radius", "start_angle", "end_angle"}), frozenset({"height"})),
+    "helix": (frozenset({"center", "radius", "turns", "height"}), frozenset({"start_angle"})),
+    "polyline": (frozenset({"waypoints"}), frozenset()),
+}
+"""Curve -> (required, optional) parameters of a ``path:`` mapping besides ``curve``."""
+_PATH_VECTORS = frozenset({"start", "end", "center"})
+
+
+def _path_params(spec: Mapping[str, Any], p: str) -> tuple[str, dict[str, Any]]:
+    """The curve's name and its parameters, each checked for type, finiteness and caps."""
+    kind = require(spec, "curve", p)
+    if not isinstance(kind, str) or kind not in _PATH_PARAMS:
+        raise fail(f"{p}.curve", f"unknown curve {show(kind)}; expected one of "
+                                 f"{', '.join(_PATH_PARAMS)}")  # fmt: skip
+    needed, optional = _PATH_PARAMS[kind]
+    check_keys(spec, needed | optional | {"curve"}, p)
+    params: dict[str, Any] = {}
+    for key in sorted(needed | (optional & set(spec))):
+        value, where = require(spec, key, p), f"{p}.{key}"
+        if key in _PATH_VECTORS:
+            params[key] = vector(value, 3, where)
+        elif key == "waypoints":
+            if isinstance(value, str | bytes) or not isinstance(value, list) or len(value) < 2:
+                raise fail(where, f"expected a list of at least 2 points, got {show(value)}")
+            check_cap(len(value), "polyline_points", where)
+            params[key] = [vector(w, 3, f"{where}[{i}]") for i, w in enumerate(value)]
+        else:
+            params[key] = number(value, where)
+    turns = params.get("turns")
+    if turns is not None and not abs(turns) <= MAX_HELIX_TURNS:
+        raise fail(f"{p}.turns", f"{show(turns)}: at most {MAX_HELIX_TURNS} turns")
+    return kind, params
+
+
 def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
-    spec = dict(mapping(g["path"], f"{p}.path"))
-    kind = require(spec, "curve", f"{p}.path")
+    spec = mapping(g["path"], f"{p}.path")
     samples = require(g, "samples", p)
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise fail(f"{p}.samples", f"expected an integer >= 1, got {show(samples)}")
@@ -96,18 +130,10 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
             f"{samples} samples; at most {MAX_PATH_SAMPLES} (each sample is a goal of its own, "
             "and needs at least one control tick)",
         )
-    spec.pop("curve")
-    turns = spec.get("turns")
-    if isinstance(turns, int | float) and not isinstance(turns, bool):
-        if not abs(turns) <= MAX_HELIX_TURNS:
-            raise fail(f"{p}.path.turns", f"{show(turns)}: at most {MAX_HELIX_TURNS} turns")
-    try:
-        curve = parametric_curve(str(kind), **spec)
+    kind, params = _path_params(spec, f"{p}.path")
+    curve = parametric_curve(kind, **params)
+    with np.errstate(all="ignore"):
         pts = np.asarray([curve(s) for s in (0.0, 0.5, 1.0)], float)
-    except ScenarioError as exc:
-        raise fail(f"{p}.path.curve", str(exc)) from None
-    except (KeyError, TypeError, ValueError) as exc:
-        raise fail(f"{p}.path", f"bad parameters for curve {show(kind)}: {exc}") from None
     if not np.all(np.isfinite(pts)):
         raise fail(f"{p}.path", "curve gives non-finite points")
     time = None if g.get("time") is None else number(g["time"], f"{p}.time")
@@ -118,6 +144,35 @@ def _parse_path_goal(g: Mapping[str, Any], p: str) -> tuple[Goal, ...]:
         point=vector(g.get("point", (0, 0, 0)), 3, f"{p}.point"),  # type: ignore[arg-type]
         weight=number(g.get("weight", 1.0), f"{p}.weight"),
     )
+
+
+def _goal_count(raw: Any) -> int:
+    """Goals a goal list stands for once its path goals expand (an unreadable ``samples``
+    counts 1: the parser names it)."""
+    if not isinstance(raw, list):
+        return 0
+    count = 0
+    for g in raw:
+        samples: Any = g.get("samples") if isinstance(g, Mapping) and "path" in g else 1
+        ok = isinstance(samples, int) and not isinstance(samples, bool)
+        count += samples if ok and 1 <= samples <= MAX_PATH_SAMPLES else 1
+    return count
+
+
+def _check_counts(d: Mapping[str, Any], bodies: list[Any], props: Any) -> None:
+    """Bodies, props and goals (after path expansion) within their caps, before any parsing."""
+    check_cap(len(bodies), "bodies", "bodies")
+    if isinstance(props, list):
+        check_cap(len(props), "props", "props")
+    lists = {f"bodies[{i}].goals": b.get("goals") for i, b in enumerate(bodies)
+             if isinstance(b, Mapping)}  # fmt: skip
+    extra = d.get("goals")
+    if isinstance(extra, Mapping):
+        lists.update((f"goals.{escaped(k)}", v) for k, v in extra.items())
+    counts = {where: _goal_count(raw) for where, raw in lists.items()}
+    for where, count in counts.items():
+        check_cap(count, "goals", where)
+    check_cap(sum(counts.values()), "goals", "goals")
 
 
 def _size(value: Any, path: str) -> tuple[float, ...]:
@@ -193,8 +248,7 @@ def _parse_prop(d: Any, path: str) -> Prop:
         wps = d["waypoints"]
         if not isinstance(wps, list) or not wps:
             raise fail(f"{path}.waypoints", "expected a non-empty list of {time, position}")
-        if len(wps) > MAX_WAYPOINTS:
-            raise fail(f"{path}.waypoints", f"{len(wps)} waypoints; at most {MAX_WAYPOINTS}")
+        check_cap(len(wps), "prop_waypoints", f"{path}.waypoints")
         out = []
         for i, w in enumerate(wps):
             wp = f"{path}.waypoints[{i}]"
@@ -217,6 +271,7 @@ def scenario_from_dict(data: Any, *, name: str | None = None) -> Scenario:
     bodies_raw = require(d, "bodies", "")
     if not isinstance(bodies_raw, list) or not bodies_raw:
         raise fail("bodies", "expected a non-empty list of bodies")
+    _check_counts(d, bodies_raw, d.get("props"))
     bodies = [_parse_body(b, f"bodies[{i}]") for i, b in enumerate(bodies_raw)]
     if d.get("goals") is not None:
         extra = mapping(d["goals"], "goals")

@@ -26,7 +26,8 @@ __all__ = ["RandomScenarioConfig", "draw_courses"]
 # Conservative need of an SGC course: acceleration _ACCEL_FACTOR * (average speed of the course
 # + of the one before) / duration, angular acceleration _ACCEL_FACTOR * angle / duration^2.
 # Against sgc_env.paper.plan on 120 random draws the plan's peak stayed below 0.93 of the bound
-# with factor 24; 30 adds margin. tests/test_scenario.py re-checks it with the planner.
+# with factor 24; 30 adds margin. tests/sgc_env/scenario/test_scenario.py re-checks it with the
+# planner.
 _ACCEL_FACTOR = 30.0
 
 

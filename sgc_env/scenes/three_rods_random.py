@@ -18,8 +18,8 @@ A draw is issue 19's 10 ms budget: its orientation courses are memoised for the 
 (``sgc_env.scenario.orientation_courses``), its small-vector arithmetic is plain floats and
 its routing skips the checks a drawn rod passes by construction (``_route``), all giving the
 floats they replaced, bit for bit.
-``tests/test_random_scenes.py`` checks the bound against the planner on fresh draws and runs
-the expert inside PyBullet on the draws.
+``tests/sgc_env/scenes/test_random_scenes.py`` checks the bound against the planner on fresh draws
+and runs the expert inside PyBullet on the draws.
 """
 
 from __future__ import annotations
@@ -85,8 +85,9 @@ of an exploratory run (the teal rod's 2.57 and 4.12: one draw; its others stayed
 and 1.8). The largest values grew with the number of draws (violet's K_S: 2.44, 2.70, 3.12),
 hence the margin."""
 BOUND_FACTORS = tuple((FACTOR_MARGIN * f, FACTOR_MARGIN * s) for f, s in MEASURED_FACTORS)
-"""What the draws use: the measured factors with a margin (``tests/test_random_scenes.py``
-checks the bound against the planner on fresh draws)."""
+"""What the draws use: the measured factors with a margin
+(``tests/sgc_env/scenes/test_random_scenes.py`` checks the bound against the planner on fresh
+draws)."""
 
 
 @dataclass(frozen=True)

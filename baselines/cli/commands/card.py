@@ -2,7 +2,7 @@
 
 Each card's held-out results come from an evaluation this command runs (``--episodes`` from
 ``--seed``, default the seed the manifest's result started at), next to the results the
-manifest recorded when the model was shipped; see :mod:`baselines.model_cards`.
+manifest recorded when the model was shipped; see :mod:`baselines.zoo.cards`.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from baselines.model_cards import entries, write_model_card
+    from baselines.zoo.cards import entries, write_model_card
 
     try:
         chosen = entries(args.models)

@@ -1,26 +1,17 @@
 """``sgc demo``: the paper's three-rod demo, flown by the expert or any policy, rendered and
-scored.
+scored (:mod:`baselines.figures.demo`: the outputs).
 
-Writes to ``--out`` (default ``runs/demo``): ``three_rods.mp4``, ``three_rods.gif``,
-``plates.png`` (8 frames, like the paper's Plates 1-8), ``deviation.png`` and ``speed.png``
-(per rod), ``goals.csv`` (one row per goal), ``summary.json`` (the harness's scorecard) and
-``rods.json`` (exactness, punctuality and smoothness per rod). ``--paper-rule`` runs the
-expert with the paper's k rules instead of the tangent rule. ``--policy SPEC`` flies any spec
-``sgc evaluate --policy`` takes (``minimum-jerk``, ``shipped:<stem>``, a model ``.zip``; model
-files load without unpickling unless ``--trust-model``) with the same outputs and scorecard.
-``--compare A,B`` (e.g. ``expert,minimum-jerk``) runs both, writes each run's outputs under
-``--out/<label>/``, the two side by side in ``compare.mp4`` (the runs' own frames), and both
-scorecards in ``summary.json`` (keyed by label). The exit status is 1 when the expert (alone
-or compared) misses a goal, 2 for bad input (an unknown spec, a model that does not fit the
-three-rod env), else 0. It prints the CPU time it took
-(``os.times``: this process since it started, plus waited-for children such as ffmpeg), the
-measure that matters on a shared machine, and the wall time.
+``--paper-rule`` runs the expert with the paper's k rules instead of the tangent rule;
+``--policy SPEC`` flies any spec ``sgc evaluate --policy`` takes; ``--compare A,B`` runs both
+and writes them side by side (:mod:`baselines.figures.demo_compare`). The exit status is 1 when
+the expert (alone or compared) misses a goal, 2 for bad input (an unknown spec, a model that
+does not fit the three-rod env), else 0. It prints the CPU time (``os.times``, ffmpeg's
+included: the measure that matters on a shared machine) and the wall time.
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -28,10 +19,12 @@ from typing import Any
 from baselines.cli.checks import (
     add_trust_argument,
     bounded_int,
+    error_exit,
     out_dir,
     staged_output,
     trust_model,
 )
+from baselines.cli.console import make_console
 
 __all__ = ["add_arguments", "run"]
 
@@ -91,7 +84,7 @@ def _labels(args: argparse.Namespace, specs: list[str]) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     import sgc_env  # noqa: F401  (registers the ids)
-    from baselines.cli.demo import DemoOptions, check_policy
+    from baselines.figures.demo import DemoOptions, check_policy
 
     try:
         specs = _specs(args)
@@ -110,98 +103,46 @@ def run(args: argparse.Namespace) -> int:
             check_policy(option)
         return _fly(args, options, labels)
     except ValueError as exc:
-        print(f"sgc demo: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("demo", exc)
 
 
 def _fly(args: argparse.Namespace, options: list[Any], labels: list[str]) -> int:
-    import dataclasses
-
     import gymnasium as gym
-    from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    from baselines.cli.demo import ENV_ID, cpu_seconds, run_demo
-    from baselines.cli.demo_compare import write_side_by_side
-    from baselines.evaluation import write_summary_json
+    from baselines.cli.console import demo_scorecard_table
+    from baselines.figures.demo import ENV_ID, cpu_seconds
+    from baselines.figures.demo_compare import fly_demos
 
-    console = Console()
+    console = make_console()
     started = time.perf_counter()
-    compare = len(options) > 1
-    results = []
     # Written next to --out and moved in at the end: an interrupted run (or a model that does
     # not load) leaves the earlier results whole (no half-written video beside old plates).
     with staged_output(args.out) as stage, Progress(
         TextColumn("three rods: {task.description}"), BarColumn(),
         TextColumn("{task.completed}/{task.total} ticks"), TimeRemainingColumn(), console=console,
     ) as bar:  # fmt: skip
-        for option, label in zip(options, labels, strict=True):
-            option = dataclasses.replace(option, out=stage / label if compare else stage)
+
+        def progress(label: str) -> Any:
             # the registry's episode length is the demo's tick count, known before the env is built
             task = bar.add_task(label, total=gym.spec(ENV_ID).max_episode_steps)
-            results.append(run_demo(option, _ticker(bar, task)))
-        files = [path for result in results for path in result.files.values()]
-        if compare:
-            files.append(write_side_by_side(results[0], results[1], stage))
-            summaries = {r.label: r.summary for r in results}
-            files.append(write_summary_json(summaries, stage / "summary.json"))
-        files = sorted(args.out / path.relative_to(stage) for path in files)
+            return lambda done, total: bar.update(task, completed=done, total=total)
+
+        results, written = fly_demos(options, labels, stage, progress)
+        files = sorted(args.out / path.relative_to(stage) for path in written)
     elapsed = time.perf_counter() - started
 
     for option, result in zip(options, results, strict=True):
-        console.print(scorecard_table(option, result))
+        console.print(demo_scorecard_table(option, result))
         summary = result.summary
         console.print(f"{result.label}: {summary['goals_met']}/{summary['n_goals']} goals met, "
                       f"terminated: {bool(summary['terminated'])}; CPU of the run "
                       f"{result.cpu_s:.1f} s")  # fmt: skip
-    console.print(
-        f"CPU {cpu_seconds():.1f} s since the command started (imports included, ffmpeg's "
-        f"too); {elapsed:.1f} s wall clock"
-    )
-    console.print(f"outputs in {args.out}/:")
-    for path in files:
-        console.print(f"  {path}")
+    console.print(f"CPU {cpu_seconds():.1f} s since the command started (imports included, "
+                  f"ffmpeg's too); {elapsed:.1f} s wall clock")  # fmt: skip
+    console.print(f"outputs in {args.out}/:", *(f"  {path}" for path in files), sep="\n")
     missed = any(
         r.summary["goals_met"] < r.summary["n_goals"] or r.summary["terminated"]
         for o, r in zip(options, results, strict=True) if o.policy == "expert"
     )  # fmt: skip
     return 1 if missed else 0
-
-
-def _ticker(bar: Any, task: Any) -> Any:
-    """``progress(done, total)`` for :func:`run_demo` that moves ``task`` of ``bar``."""
-
-    def tick(done: int, total: int) -> None:
-        bar.update(task, completed=done, total=total)
-
-    return tick
-
-
-def scorecard_table(option: Any, result: Any) -> Any:
-    """The per-rod scorecard of one run, as a rich table."""
-    from rich.table import Table
-
-    if option.policy == "expert":
-        rule = "the paper's k rules" if option.end_rule == "paper" else "the tangent rule"
-        who = f"the expert ({rule})"
-    else:
-        who = f"policy {result.label}"
-    table = Table(title=f"three-rod demo: {who}, scored by the harness")
-    table.add_column("rod", no_wrap=True)
-    for column in ("goals", "met", "max |D| (m)", "max |phi| (rad)", "closest approach (s)",
-                   "SPARC", "min speed at goals / avg", "kink (m/s²)",
-                   "ang kink (rad/s²)"):  # fmt: skip
-        table.add_column(column, justify="right")
-    for rod in result.per_rod:
-        table.add_row(
-            rod["rod"], str(rod["goals"]), str(rod["goals_met"]),
-            _fmt(rod["position_error_max_m"]), _fmt(rod["orientation_error_max_rad"]),
-            _fmt(rod["closest_approach_offset_max_s"]), _fmt(rod["sparc_track"], ".2f"),
-            _fmt(rod["goal_speed_ratio_min"], ".2f"), _fmt(rod["acceleration_kink"], ".1f"),
-            _fmt(rod["angular_acceleration_kink"], ".1f"),
-        )  # fmt: skip
-    return table
-
-
-def _fmt(value: float | None, spec: str = ".1e") -> str:
-    return "-" if value is None else format(value, spec)

@@ -83,7 +83,7 @@ def _run_minari(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     from baselines.agents.demos import record_demos
     from baselines.agents.pushes import Pushes
-    from baselines.env_kwargs import check_env_kwargs
+    from baselines.common.env_kwargs import check_env_kwargs
 
     known_env_id(args.env)
     try:

@@ -1,7 +1,8 @@
 """``sgc rollout``: one scenario, one controller, everything written down.
 
 The scenario is a built-in name or a YAML file (``--scenario``) or the one an env id draws
-for a seed (``--env ID --seed N``). DIR (default ``runs/rollout/<scenario>/<policy>``) gets
+for a seed (``--env ID --seed N``). DIR (default ``runs/rollout/<scenario>/<policy>``, from
+the command line: a scenario file's stem, a built-in name or the env id) gets
 ``trajectory.npz`` (time, per-body deviations, poses, velocities, force, torque, goal
 indices; goal times and nails), ``summary.json`` (the episode's scorecard) and the plots:
 ``deviation.png`` (each component of D and phi against time, goal times dotted),
@@ -13,14 +14,21 @@ side by side. ``--video`` adds ``rollout.mp4`` (TinyRenderer frames via imageio)
 from __future__ import annotations
 
 import argparse
-import math
-import sys
+import re
 from pathlib import Path
 from typing import Any
 
-from baselines.cli.checks import add_trust_argument, nonneg_int, out_dir, trust_model
+from baselines.cli.checks import (
+    add_trust_argument,
+    error_exit,
+    nonneg_int,
+    out_dir,
+    staged_output,
+    trust_model,
+)
+from baselines.cli.console import make_console
 
-__all__ = ["add_arguments", "make_env", "run"]
+__all__ = ["add_arguments", "default_out", "folder_name", "make_env", "run"]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -42,81 +50,64 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def make_env(scenario: str | None, env_id: str | None, render: bool) -> tuple[Any, str]:
-    """The env to roll out and a name for output folders."""
+    """The env to roll out and its name for titles (a scenario file's own ``name``, escaped:
+    it is shown, never made a path; :func:`folder_name` is the output folder's)."""
     import gymnasium as gym
 
     import sgc_env
     from sgc_env.envs.sgc_env import SGCEnv
+    from sgc_env.scenario.bounded import escaped
 
     mode = "rgb_array" if render else None
     if scenario is not None:
         loaded = sgc_env.load_scenario(scenario)
-        return SGCEnv(scenario=loaded, render_mode=mode), loaded.name
+        return SGCEnv(scenario=loaded, render_mode=mode), escaped(loaded.name, 80)
     env_id = env_id or "SGCPoint-v0"
     sgc_env.check_env_id(env_id, "env")
     return gym.make(env_id, render_mode=mode), env_id
 
 
-def _save_npz(path: Path, traj: dict[str, Any], goals: list[list[Any]]) -> None:
-    import numpy as np
+def folder_name(text: str) -> str:
+    """A name from the command line as one harmless folder name: letters, digits and
+    ``_.+-`` (anything else ``_``), never ``.``/``..`` or hidden."""
+    slug = re.sub(r"[^A-Za-z0-9_.+-]", "_", text)[:80].lstrip(".")
+    return slug or "_"
 
-    extra: dict[str, Any] = {}
-    for b, body_goals in enumerate(goals):
-        extra[f"goal_times_{b}"] = np.array([g.time for g in body_goals])
-        extra[f"nails_{b}"] = np.array(
-            [g.nail if g.nail is not None else (np.nan,) * 3 for g in body_goals], dtype=float
-        )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path, **traj, **extra)
+
+def default_out(args: argparse.Namespace, label: str) -> Path:
+    """``runs/rollout/<scenario or env>/<policy>``, from the command line only: a scenario
+    file's stem (its ``name`` field could be ``../..`` or absolute), a built-in name or an
+    env id."""
+    source = Path(args.scenario).stem if args.scenario else (args.env or "SGCPoint-v0")
+    return Path("runs/rollout") / folder_name(source) / folder_name(label)
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
 
-    from baselines.cli import plots
-    from baselines.evaluation import run_episode, write_summary_json
+    from baselines.cli.console import smoothness_line
+    from baselines.evaluation.harness import run_episode
+    from baselines.figures.rollout_files import write_rollout
     from baselines.policies import make_policy, policy_label
 
-    console = Console()
+    console = make_console()
     try:
         env, name = make_env(args.scenario, args.env, args.video)
     except ValueError as exc:
-        print(f"sgc rollout: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("rollout", exc)
     try:
         label = policy_label(args.policy)
-        out = args.out or Path("runs/rollout") / name / label
+        out = args.out or default_out(args, label)
         trust = trust_model(args, "rollout")
         policy = make_policy(args.policy, env, seed=args.seed, trust_model=trust)
         frames: list[Any] | None = [] if args.video else None
         record = run_episode(policy, env, args.seed, keep_infos=True, frames=frames)
-        traj = plots.trajectory_arrays(record.infos or [], record.initial_info)
-        _save_npz(out / "trajectory.npz", traj, record.goals)
-        write_summary_json(record.card, out / "summary.json")
         title = f"{label} on {name} (seed {args.seed})"
-        plots.plot_deviation_components(traj, record.goals, out / "deviation.png", title)
-        plots.plot_path_3d(traj, record.goals, out / "path3d.png", title)
-        plots.plot_speed_profile(traj, record.goals, out / "speed.png", title)
-        if not args.no_compare:
-            runs = {}
-            for spec, method in (
-                ("dynamic-constraints", "dynamic constraints (Fig. 1)"),
-                ("expert", "sequential-goal constraints (Fig. 2)"),
-            ):
-                if spec == args.policy:
-                    runs[method] = traj
-                    continue
-                other = run_episode(make_policy(spec, env), env, args.seed, keep_infos=True)
-                runs[method] = plots.trajectory_arrays(other.infos or [], other.initial_info)
-            plots.plot_method_comparison(runs, record.goals, out / "figure1_vs_2.png")
-        if frames:
-            import imageio
-
-            fps = int(env.unwrapped.metadata.get("render_fps", 60))
-            imageio.mimsave(out / "rollout.mp4", frames, fps=fps)
+        # written next to the output folder and moved in at the end, never through a link
+        with staged_output(out) as stage:
+            write_rollout(stage, env, record, title, args.policy, args.seed,
+                          not args.no_compare, frames)  # fmt: skip
     except ValueError as exc:
-        print(f"sgc rollout: error: {exc}", file=sys.stderr)
-        return 2
+        return error_exit("rollout", exc)
     finally:
         env.close()
     card = record.card
@@ -128,20 +119,3 @@ def run(args: argparse.Namespace) -> int:
     console.print(smoothness_line(card))
     console.print(f"[dim]wrote {out}[/dim]")
     return 0
-
-
-def smoothness_line(card: dict[str, Any]) -> str:
-    """The episode's smoothness, linear and angular: LDLJ over the track (mean over bodies),
-    peak acceleration and the largest one-tick change of acceleration (the largest over
-    bodies; docs/metrics.md)."""
-    parts = []
-    for prefix, unit, name in (("", "m/s²", "linear"), ("angular_", "rad/s²", "angular")):
-        values = [card[f"{prefix}{k}"] for k in
-                  ("ldlj_track_mean", "acceleration_peak", "acceleration_kink")]  # fmt: skip
-        if all(isinstance(v, float) and math.isnan(v) for v in values):
-            continue
-        parts.append(
-            f"{name}: LDLJ track {values[0]:.2f}, peak acceleration {values[1]:.3g} {unit}, "
-            f"largest one-tick change of acceleration {values[2]:.3g} {unit}"
-        )
-    return "; ".join(parts) if parts else "no movement to score for smoothness"

@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import shlex
 import sys
 from dataclasses import replace
-from pathlib import Path
 
 from baselines.cli.checks import (
     UsageError,
@@ -69,9 +66,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--init", choices=("none", "bc"), default="none", help="bc: clone --demos first"
     )
     parser.add_argument("--demos", type=existing_file, default=None, help="npz from `sgc demos`")
-    parser.add_argument(
-        "--bc-epochs", type=nonneg_int, default=30, help="behaviour-cloning epochs"
-    )
+    parser.add_argument("--bc-epochs", type=nonneg_int, default=30, help="behaviour-cloning epochs")
     parser.add_argument(
         "--bc-log-std", type=float, default=-2.0, help="PPO exploration after cloning"
     )
@@ -102,42 +97,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--verbose", type=nonneg_int, default=0, help="SB3 verbosity (0, 1, 2)")
 
 
-def whole_rollouts(algo: str, env_id: str, timesteps: int | None, folder: str | None) -> int | None:
-    """``timesteps`` rounded up to what SB3 really trains: PPO collects whole rollouts of
-    ``n_steps`` per env, the off-policy algorithms one step per env at a time."""
-    if not timesteps:
-        return timesteps
-    from baselines.agents.hyperparams import load_hyperparams
-
-    hp = load_hyperparams(algo, env_id, folder)
-    chunk = hp.n_envs * (int(hp.algo_kwargs.get("n_steps", 2048)) if algo == "ppo" else 1)
-    return math.ceil(timesteps / chunk) * chunk
-
-
-def _record_out(config: Path, out: Path) -> None:
-    """``config.json`` names the run folder, not the stage it was written in."""
-    data = json.loads(config.read_text())
-    data["train_config"]["out"] = str(out)
-    config.write_text(json.dumps(data, indent=1))
-
-
 def run(args: argparse.Namespace) -> int:
-    from baselines.agents.train import TrainConfig, train
-    from baselines.cli.console import summary_line
+    from baselines.agents.budget import whole_rollouts
+    from baselines.agents.hyperparams import load_hyperparams
+    from baselines.agents.train import TrainConfig, record_run_folder, train
+    from baselines.cli.console import print_training
 
     known_env_id(args.env)
     if args.init == "bc" and args.demos is None:
         raise UsageError("--init bc needs --demos (an npz from `sgc demos`)")
-    timesteps = args.timesteps
-    try:
-        timesteps = whole_rollouts(args.algo, args.env, args.timesteps, args.hyperparams)
+    try:  # parsed once, here, for the rounding below and for train()
+        hp = load_hyperparams(args.algo, args.env, args.hyperparams)
     except ValueError:
-        pass  # train() reports a bad algo, env or hyperparameter file with its own message
+        hp = None  # train() reports a bad algo, env or hyperparameter file with its own message
+    timesteps = args.timesteps
+    if timesteps and hp is not None:
+        timesteps = whole_rollouts(timesteps, args.algo, hp)
     if timesteps != args.timesteps:
-        print(
-            f"note: --timesteps {args.timesteps} rounds up to {timesteps} "
-            f"({args.algo} trains whole rollouts: n_envs x n_steps)"
-        )
+        print(f"note: --timesteps {args.timesteps} rounds up to {timesteps} "
+              f"({args.algo} trains whole rollouts: n_envs x n_steps)")  # fmt: skip
     pushes = {f"push_{key}": value for key, value in push_options(args).items()}
     cfg = TrainConfig(
         algo=args.algo, env_id=args.env, seed=args.seed, timesteps=timesteps,
@@ -153,34 +131,13 @@ def run(args: argparse.Namespace) -> int:
     )  # fmt: skip
     try:
         if args.out is None:
-            result = train(cfg)
+            result = train(cfg, hp)
         else:  # staged next to --out: an interrupted run leaves the earlier run's files whole
             with staged_output(args.out, keep_on_failure=("checkpoints",)) as stage:
-                result = train(replace(cfg, out=stage))
-                _record_out(stage / "config.json", args.out)
+                result = train(replace(cfg, out=stage), hp)
+                record_run_folder(stage, args.out)
             result.model_path = args.out / "final_model.zip"
     except ValueError as exc:  # a bad input file (demos, hyperparameters) found while training
         raise UsageError(str(exc)) from None
-    if args.time_budget is not None:
-        spent = "spent" if result.config["budget_spent"] else "not spent"
-        print(f"time budget {args.time_budget:g} s {spent}: {result.timesteps} steps reached "
-              f"in {result.config['train_time_s']:.1f} s of training")  # fmt: skip
-    print(
-        f"{args.algo} on {args.env}: {result.timesteps} steps, learn {result.learn_time_s:.1f} s "
-        f"({result.steps_per_s:.0f} steps/s), total {result.wall_time_s:.1f} s"
-    )
-    if result.bc:
-        print(f"bc: loss {result.bc['loss_before']:.4g} -> {result.bc['loss_after']:.4g}")
-    if result.model_path is not None:
-        print(f"model: {result.model_path}")
-    if result.evaluations:
-        last = result.evaluations[-1]
-        where = f"; every entry in {args.out}/evaluations.json" if args.out else ""
-        print(
-            f"evaluation at {last['timesteps']} steps ({args.eval_episodes} episodes from seed "
-            f"{args.eval_seed}{where}):\n{summary_line(last)}"
-        )
-    else:
-        print("not evaluated (add --eval-freq N or --eval-every-s S to score the model with the "
-              "harness)")  # fmt: skip
+    print_training(result, cfg, args.out)
     return 0

@@ -1,11 +1,11 @@
 """N sub-envs in shared PyBullet worlds, stepped together: the core of both vector env APIs.
 
 Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) built on a
-:class:`~sgc_env.envs.world.WorldView` of a :class:`~sgc_env.envs.world.SharedWorld`; the
-scenes are spread over worlds of about :data:`SHARD_OBJECTS` objects (why: there). A control
+:class:`~.world.WorldView` of a :class:`~.world.SharedWorld`; the scenes are spread over
+worlds of about :data:`SHARD_OBJECTS` bodies (why: there). A control
 step gathers every stepping sub-env's drives, runs each world's substeps once, then observes
-every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.batched``) adapters
-differ only in their reset conventions and in how they batch what this returns.
+every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.agents.sb3_vec_env``)
+adapters differ only in their reset conventions and in how they batch what this returns.
 
 A sub-env that does not step in a call (it is being reset) still has bodies in the world that
 the substeps integrate; its reset comes after the physics and overwrites their state, so it
@@ -13,8 +13,8 @@ starts exactly where a single env's reset would.
 
 Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one; :data:`FAST_MIN_ENVS` or
 more of them) step by the fast path,
-:meth:`Batch.step_fast`: the task work of all sub-envs at once in numpy
-(:class:`~sgc_env.envs.batch_task.BatchTask`), the sub-env objects brought up to date only
+:meth:`Batch.step_fast`: the single env's task rules run on all sub-envs at once
+(:class:`~.task.BatchTask`), the sub-env objects brought up to date only
 when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
 ``_finish_step`` (:meth:`Batch.step`).
 """
@@ -78,7 +78,7 @@ def check_num_envs(num_envs: object) -> int:
     if not 1 <= num_envs <= MAX_ENVS:
         raise ValueError(
             f"num_envs must be in [1, {MAX_ENVS}], got {num_envs} (the cap: see "
-            "sgc_env.envs.batch.MAX_ENVS)"
+            "sgc_env.envs.vector.batch.MAX_ENVS)"
         )
     return num_envs
 

@@ -3,7 +3,7 @@
 ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point")`` builds N sub-envs
 in a few shared PyBullet worlds (:mod:`.batch`); each sub-env's observations, rewards, flags
 and goal events equal those of ``gym.make(id)`` with the same seeds and actions, bit for bit
-(tests/test_batched.py). Conventions:
+(tests/sgc_env/envs/test_batch.py). Conventions:
 
 - ``single_observation_space`` / ``single_action_space``; batched spaces from Gymnasium;
 - next-step autoreset (``metadata["autoreset_mode"]``): the step after a sub-env ends resets
@@ -155,7 +155,7 @@ class SGCVectorEnv(VectorEnv):
             self._obs[i] = obs
             rewards[i], terminated[i], truncated[i] = reward, term, trunc
             infos.append(info)
-        for i in resetting:  # after the physics: see sgc_env.envs.batch
+        for i in resetting:  # after the physics: see sgc_env.envs.vector.batch
             self._obs[i], info = self._batch.reset_one(i)
             infos.append(info)
         self._autoreset = terminated | truncated
@@ -170,7 +170,7 @@ class SGCVectorEnv(VectorEnv):
         """:meth:`step` of plain SGC sub-envs: arrays from the batch's shared buffers."""
         batch = self._batch
         rewards, terminated, truncated, events = batch.step_fast(stepping, actions)
-        for i in resetting:  # after the physics: see sgc_env.envs.batch
+        for i in resetting:  # after the physics: see sgc_env.envs.vector.batch
             self._obs[i] = batch.reset_one(i)[0]
         if resetting:
             rewards[resetting] = 0.0

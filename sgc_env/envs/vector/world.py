@@ -88,7 +88,7 @@ class SharedWorld:
             raise ValueError(
                 f"scenario {s.name!r}: objects {colliding} collide with each other; contacts "
                 "inside one sub-env of a shared world are not bit-identical to a single env's "
-                "(see sgc_env/envs/world.py), so the batched env takes scenes with at most "
+                "(see sgc_env/envs/vector/world.py), so the batched env takes scenes with at most "
                 "one colliding object: set collisions: false or use single envs"
             )
         g = tuple(float(x) for x in s.gravity)

@@ -1,0 +1,1 @@
+"""Pictures of episodes: GIFs, plots and the three-rod demo."""

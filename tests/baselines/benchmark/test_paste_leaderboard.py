@@ -1,0 +1,53 @@
+"""scripts/paste_leaderboard.py: a leaderboard lands between its own marker pair only."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _paste_module():
+    path = ROOT / "scripts" / "paste_leaderboard.py"
+    spec = importlib.util.spec_from_file_location("paste_leaderboard", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+DOC = """intro
+<!-- leaderboard:begin -->
+old steps table
+<!-- leaderboard:end -->
+middle
+<!-- budget-leaderboard:begin -->
+old budget table
+<!-- budget-leaderboard:end -->
+outro
+"""
+
+
+def test_each_marker_pair_takes_its_own_leaderboard() -> None:
+    paste = _paste_module()
+    body = paste.leaderboard_body("# Leaderboard\n\n## SGCRod-v0\n\n| a |\n")
+    assert body == "### SGCRod-v0\n\n| a |"
+    out = paste.paste(DOC, body, "doc", "budget-leaderboard")
+    assert "old budget table" not in out and "old steps table" in out
+    assert out.count("### SGCRod-v0") == 1
+    assert out.index("### SGCRod-v0") > out.index("middle")
+    out = paste.paste(out, "steps", "doc")  # the default pair
+    assert "old steps table" not in out and "### SGCRod-v0" in out
+
+
+def test_a_missing_or_doubled_marker_is_an_error_naming_the_document() -> None:
+    paste = _paste_module()
+    with pytest.raises(ValueError, match=r"README\.md: needs exactly one <!-- other:begin -->"):
+        paste.paste(DOC, "x", "README.md", "other")
+    with pytest.raises(ValueError, match="needs exactly one"):
+        paste.paste(DOC + DOC, "x", "README.md")
+    with pytest.raises(ValueError, match="no '# ' title line"):
+        paste.leaderboard_body("| a |")

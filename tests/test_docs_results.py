@@ -1,0 +1,93 @@
+"""The results tables of the README and docs/ are what their commands write now.
+
+Each table sits between markers with its command (scripts/paste_results.py); the cheap ones
+are rerun here and compared with the docs, the scorecards (a minute or more of CPU) in the
+slow tests. A failure means: rerun ``python scripts/paste_results.py NAME --run``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import shlex
+import sys
+from pathlib import Path
+
+import pytest
+
+from baselines.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _paste():
+    spec = importlib.util.spec_from_file_location(
+        "paste_results", ROOT / "scripts" / "paste_results.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+paste = _paste()
+
+
+def _pasted(name: str) -> list[tuple[Path, str]]:
+    """Every (document, block text) holding the block ``name``."""
+    begin, _ = paste.markers(name)
+    return [(doc, paste.block(doc.read_text(), name, str(doc))) for doc in paste.documents()
+            if begin in doc.read_text()]  # fmt: skip
+
+
+def _rerun(name: str, out: Path) -> str:
+    """Run the block's command with its output under ``out``; the block it gives."""
+    argv = shlex.split(paste.RESULTS[name].command)[1:]
+    argv[argv.index("--out") + 1] = str(out)
+    if argv[0] == "demo":
+        argv.append("--no-video")
+    assert main(argv) == 0
+    return paste.body_from(name, out / Path(paste.RESULTS[name].output).name)
+
+
+def test_every_marker_pair_in_the_docs_is_a_known_table() -> None:
+    names = set(paste.RESULTS) | {paste.SUMMARY}
+    for doc in paste.documents():
+        for name in re.findall(r"<!-- ([\w-]+):begin -->", doc.read_text()):
+            known = name in names or name in ("leaderboard", "budget-leaderboard")
+            assert known, f"{doc.name}: block {name!r} has no command in paste_results.py"
+
+
+@pytest.mark.parametrize("name", ["paper-rule", "demo", "demo-learned"])
+def test_cheap_tables_are_what_their_commands_write(name: str, tmp_path: Path) -> None:
+    where = _pasted(name)
+    assert where, f"no document holds the {name} table"
+    expected = _rerun(name, tmp_path / name)
+    for doc, text in where:
+        assert text == expected, f"{doc.relative_to(ROOT)}: the {name} table is stale"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["scorecard", "smoothness"])
+def test_scorecards_are_what_their_commands_write(name: str, tmp_path: Path) -> None:
+    expected = _rerun(name, tmp_path / name)
+    for doc, text in _pasted(name):
+        assert text == expected, f"{doc.relative_to(ROOT)}: the {name} table is stale"
+
+
+def test_readme_summary_is_the_results_leaderboard() -> None:
+    ((readme, text),) = _pasted(paste.SUMMARY)
+    assert readme.name == "README.md"
+    assert text == paste.summary_block((ROOT / paste.SUMMARY_SOURCE).read_text())
+    assert "| `SGCRod-v0` | `ppo-rod300-300s` | no | 10 | 76 | 0.92 [0.84, 0.98] |" in text
+
+
+def test_a_table_needs_its_markers_once() -> None:
+    with pytest.raises(ValueError, match=r"README\.md: needs exactly one <!-- demo:begin -->"):
+        paste.replace("no markers", "demo", "x", "README.md")
+    doc = "a\n<!-- demo:begin -->\nold\n<!-- demo:end -->\nb"
+    assert (
+        paste.replace(doc, "demo", "new", "d")
+        == "a\n<!-- demo:begin -->\nnew\n<!-- demo:end -->\nb"
+    )
