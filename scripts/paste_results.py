@@ -89,10 +89,10 @@ def demo_table(rods: list[dict[str, object]]) -> str:
     columns and their formats have one home)."""
     from types import SimpleNamespace
 
-    from baselines.cli.commands.demo import scorecard_table
+    from baselines.cli.console import demo_scorecard_table
 
     option = SimpleNamespace(policy="", end_rule="")
-    table = scorecard_table(option, SimpleNamespace(label="", per_rod=rods))
+    table = demo_scorecard_table(option, SimpleNamespace(label="", per_rod=rods))
     head = [str(c.header).replace("|", "\\|") for c in table.columns]
     rows = zip(*(list(c.cells) for c in table.columns), strict=True)
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
