@@ -26,7 +26,7 @@ __all__ = ["body_block", "pack_blocks", "residuals"]
 
 def residuals(values: list[Any]) -> list[Any]:
     """``x - float32(x)`` of every value (what the float32 observation loses)."""
-    if not isinstance(values[0], np.ndarray):
+    if values[0].__class__ is not np.ndarray:
         return float32_residuals(values)
     exact = np.stack(np.broadcast_arrays(*values))
     return list(map(operator.sub, exact, exact.astype(np.float32).astype(np.float64)))
