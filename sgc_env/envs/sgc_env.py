@@ -99,7 +99,9 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
 :class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
 ``reward`` (``"schedule"``, ``"distance"`` or
-``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
+``"sparse"``, above, or any :class:`~sgc_env.envs.rewards.RewardMode` instance),
+``observation`` (``"planner"``, the layout above, or any
+:class:`~sgc_env.envs.views.ObservationView` instance). ``reset(options={"scenario": ...})`` swaps the
 scenario (same number of bodies and action size; a random-scenario env draws again on the next
 plain reset).
 """

@@ -4,7 +4,7 @@ Why: with N sub-envs in one world the physics is a small part of a step; the res
 times the single env's per-body Python. :class:`BatchTask` holds every sub-env's state in
 (N, bodies, ...) arrays and calls the very rules the single env calls, with arrays over
 (sub-envs, bodies) where the single env passes one body's floats: actuation
-(:func:`~sgc_env.envs.actuation.body_wrench`, :func:`~sgc_env.envs.actuation.com_path`),
+(:func:`~sgc_env.envs.actuation.body_drive`),
 measurement (:func:`~sgc_env.envs.measure.measure`), failure
 (:func:`~sgc_env.envs.failure.body_flags`), the reward mode (its one ``reward`` method), the
 step record (:func:`~sgc_env.envs.record.body_block`) and the observation view. Goal switching
