@@ -101,9 +101,9 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``reward`` (``"schedule"``, ``"distance"`` or
 ``"sparse"``, above, or any :class:`~sgc_env.envs.rewards.RewardMode` instance),
 ``observation`` (``"planner"``, the layout above, or any
-:class:`~sgc_env.envs.views.ObservationView` instance). ``reset(options={"scenario": ...})`` swaps the
-scenario (same number of bodies and action size; a random-scenario env draws again on the next
-plain reset).
+:class:`~sgc_env.envs.views.ObservationView` instance). ``reset(options={"scenario": ...})``
+swaps the scenario (same number of bodies and action size; a random-scenario env draws again
+on the next plain reset).
 """
 
 from __future__ import annotations
