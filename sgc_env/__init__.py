@@ -14,6 +14,7 @@ from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_sce
 
 __all__ = [
     "ENV_IDS",
+    "LEARNER_IDS",
     "check_env_id",
     "Body",
     "Goal",
@@ -36,6 +37,23 @@ _REGISTRY: dict[str, tuple[str, dict]] = {
     "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
 }
 ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
+"""The ids on the planner's view and the ``schedule`` reward: the benchmark's leaderboards,
+the shipped models and the scorecard use these versions."""
+
+_LEARNER = {"observation": "learner", "reward": "tracking"}
+_NEXT_VERSION = {
+    "SGCPoint-v0": "SGCPoint-v1", "SGCRod-v0": "SGCRod-v1", "SGCThreeRods-v1": "SGCThreeRods-v2",
+    "SGCIntercept-v0": "SGCIntercept-v1", "SGCInterceptRandom-v0": "SGCInterceptRandom-v1",
+    "SGCThreeRodsRandom-v2": "SGCThreeRodsRandom-v3", "SGCPointGoal-v0": "SGCPointGoal-v1",
+}  # fmt: skip
+LEARNER_IDS: tuple[str, ...] = tuple(_NEXT_VERSION.values())
+"""The newest version of every id: the same scenes and dynamics with the learner's view
+(``observation="learner"``, :mod:`sgc_env.envs.learner_view`) and, but for the goal id (whose
+reward is its sparse goal reward), the ``tracking`` reward (:mod:`sgc_env.envs.rewards`)."""
+for _old, _new in _NEXT_VERSION.items():
+    _entry, _kwargs = _REGISTRY[_old]
+    _extra = {"observation": "learner"} if _entry.startswith(_GOAL) else _LEARNER
+    _REGISTRY[_new] = (_entry, {**_kwargs, **_extra})
 
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
@@ -60,5 +78,5 @@ def check_env_id(env_id: object, field: str = "env_id") -> str:
     """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
     SGC ids (the one check of the package, the harness, training and the CLI)."""
     if not isinstance(env_id, str) or env_id not in gym.registry:
-        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS + LEARNER_IDS)}")
     return env_id

@@ -69,6 +69,7 @@ __all__ = [
     "ScheduleReward",
     "SparseReward",
     "StepScore",
+    "TrackingReward",
     "TrackReading",
     "distance_cost",
     "effort",
@@ -77,8 +78,10 @@ __all__ = [
     "make_reward",
     "reward_mode",
     "schedule_cost",
+    "schedule_error",
     "square_sum",
     "track_costs",
+    "tracking_score",
     "tracks_of",
 ]
 
@@ -157,8 +160,8 @@ def effort(step: StepScore) -> Any:
     return EFFORT_WEIGHT * step.square_sum / step.action_size
 
 
-def schedule_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
-    """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
+def schedule_error(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``|D - D_sched| / L`` (see the module docstring), uncapped."""
     ahead = left >= 0.0
     if ahead is True or ahead is not False and ahead.all():  # all_ inline: see elementwise
         f = left / c[3]
@@ -172,7 +175,17 @@ def schedule_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -
         rz = where(ahead, c[2] * f, -c[10] * left)
     ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
     scale = at_least(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
-    return at_most(sqrt(ex * ex + ey * ey + ez * ez) / scale, TRACK_COST_CAP)
+    return sqrt(ex * ex + ey * ey + ez * ez) / scale
+
+
+def schedule_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
+    return at_most(schedule_error(d, left, c, floor), TRACK_COST_CAP)
+
+
+def tracking_score(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``1 / (1 + |D - D_sched| / L)``: 1 on the schedule, falling at every distance."""
+    return 1.0 / (1.0 + schedule_error(d, left, c, floor))
 
 
 def distance_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
@@ -276,6 +289,26 @@ class SparseReward(RewardMode):
 
     def reward(self, step: StepScore) -> Any:
         return failure_charge(step, -0.0 / step.n_bodies - effort(step) + step.bonus, 0.0)
+
+
+@reward_mode
+class TrackingReward(RewardMode):
+    """The default of the ids' newest versions: ``mean_b sum_tracks 1 / (1 + x)`` with ``x =
+    |D - D_sched| / L``, plus ``0.01 (1 - mean(a^2))`` and the goal bonuses; no failure charge.
+
+    The same on-schedule error as ``schedule``, paid in a form a learner can climb: every step
+    alive earns between 0 and the number of tracks, so leaving the workspace loses what the
+    rest of the episode would have paid (no lump charge that a value function has to predict),
+    and ``1 / (1 + x)`` falls at every distance (``schedule``'s ``min(x, 1)`` is flat beyond a
+    course length, where an untrained body spends its first episodes). Undiscounted, it ranks
+    policies that finish the episode as ``schedule`` does, up to a constant per scenario.
+    """
+
+    name = "tracking"
+
+    def reward(self, step: StepScore) -> Any:
+        score, _ = track_costs(step, tracking_score)
+        return score / step.n_bodies + EFFORT_WEIGHT - effort(step) + step.bonus
 
 
 REWARD_MODES: tuple[str, ...] = tuple(REWARD_CLASSES)

@@ -315,6 +315,7 @@ class SGCEnv(gym.Env):
             substeps=self.substeps, sim_frequency=self.sim_frequency,
         )  # fmt: skip
         self.torque_scale = self._actuation.torque_scale
+        self._view_constants = self._view.constants(self)
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
@@ -398,7 +399,7 @@ class SGCEnv(gym.Env):
         self._record.pack_into(buffer, 0, *flat)
         arr = np.frombuffer(buffer)
         size = self._block_end
-        self._obs = self._view.observe(arr)
+        self._obs = self._view.observe(arr, self._view_constants)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
         self._failed = not ok

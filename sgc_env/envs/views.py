@@ -11,6 +11,8 @@ batched env hands the array out as it is. Both envs run the same
 
 from __future__ import annotations
 
+from typing import Any
+
 import gymnasium as gym
 import numpy as np
 
@@ -21,6 +23,7 @@ from .choices import choose
 __all__ = ["OBS_BOUND", "VIEWS", "ObservationView", "PlannerView", "make_view", "observation_view"]
 
 OBS_BOUND = 1e5
+_NO_CONSTANTS = np.zeros(0)
 
 
 class ObservationView:
@@ -43,9 +46,15 @@ class ObservationView:
         """The observation space of one sub-env."""
         raise NotImplementedError
 
-    def observe(self, record: np.ndarray) -> np.ndarray:
-        """The observations (N, size) float32 of N sub-envs' step records (N, record); for one
-        env, a record (record,) gives its observation (size,) (index with ``...``)."""
+    def constants(self, env: Any) -> np.ndarray:
+        """What the view needs of a sub-env besides its step record, fixed for an episode (the
+        env calls it when a scene is committed; the batched env stacks the rows): none here."""
+        return _NO_CONSTANTS
+
+    def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
+        """The observations (N, size) float32 of N sub-envs' step records (N, record) and their
+        :meth:`constants` (N, k); for one env, a record (record,) gives its observation
+        (size,) (index with ``...``)."""
         raise NotImplementedError
 
 
@@ -69,7 +78,7 @@ class PlannerView(ObservationView):
     def space(self) -> gym.spaces.Box:
         return gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
 
-    def observe(self, record: np.ndarray) -> np.ndarray:
+    def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
         return record[..., : self._size].astype(np.float32)
 
     _size = 0

@@ -113,7 +113,8 @@ class BatchTask:
         self.ptl, self.otl = z((n, b)), z((n, b))
         self.failed, self.spin = z(n, dtype=bool), z(n, dtype=bool)
         self.rec = z((n, self.record_size))
-        self.obs = self.view.observe(self.rec)
+        self.view_constants = np.stack([env._view_constants for env in envs])
+        self.obs = self.view.observe(self.rec, self.view_constants)
         self._shared = False
         self.props: list[int] = []
         self._uids: list[int] = []
@@ -146,6 +147,7 @@ class BatchTask:
         has_props = bool(env._prop_uids)
         if has_props != (i in self.props):
             self.props = sorted({*self.props, i} if has_props else set(self.props) - {i})
+        self.view_constants[i] = env._view_constants
         self.load_goals(i)
         if record:
             if self._shared:  # handed out: later loads must not change them
@@ -397,5 +399,5 @@ class BatchTask:
         rec[:, size : size + 3 * b] = self.point.reshape(n, -1)
         rec[:, size + 3 * b :] = self.applied
         self.rec = rec
-        self.obs = self.view.observe(rec)
+        self.obs = self.view.observe(rec, self.view_constants)
         self._shared = False

@@ -140,7 +140,7 @@ def run_pair(
     return resets
 
 
-@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)
+@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS + sgc_env.LEARNER_IDS)
 def test_every_id_equals_single_envs_under_random_actions(env_id: str) -> None:
     n, steps = SIZES.get(env_id, (3, 150))
     assert run_pair(env_id, n, steps) >= 2  # random actions leave the workspace: autoresets
@@ -172,7 +172,7 @@ class _ClockView(ObservationView):
     def space(self) -> gym.spaces.Box:
         return gym.spaces.Box(-1e5, 1e5, (3 * self.layout.n_bodies + 1,), np.float32)
 
-    def observe(self, record: np.ndarray) -> np.ndarray:
+    def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
         layout = self.layout
         parts = [record[..., layout.body_slice(j, "position")] for j in range(layout.n_bodies)]
         parts.append(record[..., layout.global_slice("time")])
@@ -182,8 +182,8 @@ class _ClockView(ObservationView):
 @pytest.mark.parametrize("env_id", ["SGCThreeRods-v1", "SGCPointGoal-v0"])
 def test_a_custom_observation_view_observes_the_same_in_both(env_id: str) -> None:
     assert run_pair(env_id, 2, 50, observation=_ClockView(), max_episode_steps=20) >= 2
-    with pytest.raises(ValueError, match="observation: unknown view 'learner'.*planner"):
-        gym.make(env_id, observation="learner")
+    with pytest.raises(ValueError, match="observation: unknown view 'pixels'.*planner"):
+        gym.make(env_id, observation="pixels")
 
 
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])
