@@ -321,6 +321,12 @@ class SGCEnv(gym.Env):
             tuple(map(float, s.workspace[1])),
         )
 
+    @property
+    def observation_view(self) -> str:
+        """The name of the view this env observes (``"planner"``, ``"learner"``, or a custom
+        view's ``name``)."""
+        return self._view.name
+
     # ---------------------------------------------------------------- reset / step
 
     def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
