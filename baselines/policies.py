@@ -217,7 +217,8 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
             f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
             f"{type(env.observation_space).__name__}"
         )
-    view = getattr(_spaces_env(env).unwrapped, "observation_view", "planner")
+    first = getattr(env, "envs", [env])[0] if isinstance(env, gym.vector.VectorEnv) else env
+    view = getattr(getattr(first, "unwrapped", first), "observation_view", "planner")
     if view != "planner":
         raise ValueError(
             f"policy {spec!r} reads the planner's view; this env observes the {view!r} view: "

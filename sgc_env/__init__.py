@@ -78,5 +78,6 @@ def check_env_id(env_id: object, field: str = "env_id") -> str:
     """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
     SGC ids (the one check of the package, the harness, training and the CLI)."""
     if not isinstance(env_id, str) or env_id not in gym.registry:
-        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS + LEARNER_IDS)}")
+        known = list(ENV_IDS + LEARNER_IDS)
+        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {known}")
     return env_id

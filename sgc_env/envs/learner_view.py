@@ -10,7 +10,7 @@ hands it over. Per body and track (position of the tracked point, then orientati
 |---|---|---|---|
 | on-schedule error ``D - D_sched`` | 3 | 0.05 m (rad), squashed | what the reward charges |
 | its rate ``D' - D'_sched`` | 3 | 0.5 m/s (rad/s), squashed | the damping a tracker needs |
-| schedule velocity ``D'_sched`` | 3 | 1 m/s (rad/s), squashed | feed-forward: where the course goes |
+| schedule velocity ``D'_sched`` | 3 | 1 m/s (rad/s), squashed | feed-forward: the course's way |
 | next course's schedule velocity | 3 | 1 m/s (rad/s), squashed | feed-forward across the goal |
 | current goal relative to the body | 3 | 1 m (rad), squashed | a preview, as Fetch gives goals |
 | next goal relative to the body | 3 | 1 m (rad), squashed | the preview one goal further |
