@@ -51,6 +51,7 @@ __all__ = [
     "algorithm_from_data",
     "load_sb3_model",
     "make_policy",
+    "needs_planner_view",
     "policy_label",
     "policy_labels",
     "trusted_models",
@@ -216,6 +217,22 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
             f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
             f"{type(env.observation_space).__name__}"
         )
+    first = getattr(env, "envs", [env])[0] if isinstance(env, gym.vector.VectorEnv) else env
+    view = getattr(getattr(first, "unwrapped", first), "observation_view", "planner")
+    if view != "planner":
+        raise ValueError(
+            f"policy {spec!r} reads the planner's view; this env observes the {view!r} view: "
+            "make it with observation='planner' (gym.make(id, observation='planner'), as the "
+            "harness does for this policy)"
+        )
+
+
+def needs_planner_view(spec: str) -> bool:
+    """Whether the policy ``spec`` names reads the planner's view (the expert and the
+    comparison controllers): the harness then makes its env with ``observation="planner"``,
+    the same scenes and dynamics on any version of an id."""
+    builtin = POLICY_FACTORIES.get(resolve_policy_spec(spec)) if isinstance(spec, str) else None
+    return builtin is not None and builtin.flat
 
 
 def _spaces_env(env: Any) -> Any:
@@ -227,7 +244,7 @@ def _spaces_env(env: Any) -> Any:
     if not envs:
         raise ValueError(
             f"policy: {type(env).__name__} keeps its sub-envs out of reach; use the SGC batched "
-            "env (sgc_env.envs.vector_env.make_vec) or SyncVectorEnv"
+            "env (sgc_env.envs.vector.vector_env.make_vec) or SyncVectorEnv"
         )
     return envs[0]
 

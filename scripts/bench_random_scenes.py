@@ -36,7 +36,7 @@ import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the ids)
-from sgc_env.envs.vector_env import make_vec
+from sgc_env.envs.vector.vector_env import make_vec
 from sgc_env.scenario import demand
 from sgc_env.scenes import intercept, random_scenario, three_rods_random
 

@@ -1,6 +1,6 @@
 """PyBullet's ``stepSimulation`` cost per body in one world of N free bodies without collision
-shapes (the bodies of the batched env's worlds): why ``sgc_env.envs.batch`` spreads its scenes
-over worlds of about ``SHARD_OBJECTS`` objects. Prints us per body-step for each N.
+shapes (the bodies of the batched env's worlds): why ``sgc_env.envs.vector.batch`` spreads its
+scenes over worlds of about ``SHARD_OBJECTS`` objects. Prints us per body-step for each N.
 
     .venv/bin/python scripts/bench_world_step.py --n 1 2 4 8 16 32 64 128 256
 """

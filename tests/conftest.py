@@ -13,6 +13,7 @@ import contextlib
 import weakref
 from collections.abc import Iterator
 
+import gymnasium as gym
 import pytest
 
 from sgc_env.envs import SGCEnv
@@ -41,3 +42,14 @@ def closing_every_env() -> Iterator[weakref.WeakSet[SGCEnv]]:
 def close_envs() -> Iterator[weakref.WeakSet[SGCEnv]]:
     with closing_every_env() as made:
         yield made
+
+
+@pytest.fixture(params=["single", "batched"])
+def make_env(request: pytest.FixtureRequest):  # type: ignore[no-untyped-def]
+    """``gym.make`` or a batched env of one seen as a single env: a test that makes its env
+    with this runs on both (tests/one_or_many.py)."""
+    if request.param == "single":
+        return gym.make
+    from tests.one_or_many import BatchOfOne
+
+    return BatchOfOne

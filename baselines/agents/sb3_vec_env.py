@@ -1,6 +1,6 @@
 """SB3 ``VecEnv`` over the batched env: N sub-envs in shared PyBullet worlds, SB3's conventions.
 
-The sub-envs are the batched env's (:mod:`sgc_env.envs.batch`), so each steps exactly as
+The sub-envs are the batched env's (:mod:`sgc_env.envs.vector.batch`), so each steps exactly as
 ``gym.make(id)`` inside ``DummyVecEnv`` would; what changes is SB3's side of the contract:
 a sub-env that ends is reset in the same step (after the world's physics), its last
 observation in ``info["terminal_observation"]`` and ``info["TimeLimit.truncated"]`` set as
@@ -21,10 +21,10 @@ from stable_baselines3.common.env_util import is_wrapped, make_vec_env
 from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecEnv, VecMonitor
 
 from sgc_env import check_env_id
-from sgc_env.envs.batch import Batch
-from sgc_env.envs.batch_infos import row_infos
 from sgc_env.envs.goal_env import SGCGoalEnv
 from sgc_env.envs.sgc_env import SGCEnv
+from sgc_env.envs.vector.batch import Batch
+from sgc_env.envs.vector.infos import row_infos
 
 __all__ = ["VEC_KINDS", "BatchedVecEnv", "has_batched", "make_sgc_vec"]
 
@@ -146,7 +146,7 @@ class BatchedVecEnv(VecEnv):
 def has_batched(env_id: str) -> bool:
     """Whether ``env_id`` has the batched env (every SGC id)."""
     entry = gym.spec(check_env_id(env_id)).vector_entry_point
-    return isinstance(entry, str) and entry.startswith("sgc_env.envs.vector_env:")
+    return isinstance(entry, str) and entry.startswith("sgc_env.envs.vector.vector_env:")
 
 
 def make_sgc_vec(

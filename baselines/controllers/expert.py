@@ -89,6 +89,12 @@ class SGCExpert:
         if model is None:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
+            view = getattr(getattr(env, "unwrapped", env), "observation_view", "planner")
+            if view != "planner":
+                raise ValueError(
+                    f"SGCExpert reads the planner's view; this env observes the {view!r} view: "
+                    "make it with gym.make(id, observation='planner')"
+                )
             model = EnvModel.from_env(env)
         if end_rule is not None and end_rule not in EXPERT_RULES:
             raise ValueError(f"end_rule must be one of {list(EXPERT_RULES)}, got {end_rule!r}")

@@ -19,7 +19,7 @@ import gymnasium as gym
 import numpy as np
 
 from baselines.policies import Policy
-from sgc_env.envs.vector_env import SGCVectorEnv
+from sgc_env.envs.vector.vector_env import SGCVectorEnv
 from sgc_env.metrics import GoalSpec, Tolerances, goals_from_scenario, score_episode
 
 __all__ = ["EpisodeRecord", "run_episode", "run_episodes_batched", "sub_info"]
@@ -153,7 +153,8 @@ def run_episodes_batched(
     max_steps: int = 100_000,
 ) -> list[EpisodeRecord]:
     """Episode k from ``reset(seed=seeds[k])``, run on the sub-envs of ``env`` (an SGC batched
-    env, :func:`sgc_env.envs.vector_env.make_vec`) as they come free; records in episode order.
+    env, :func:`sgc_env.envs.vector.vector_env.make_vec`) as they come free; records in episode
+    order.
 
     Each sub-env resets by ``options["reset_mask"]`` with its next episode's seed once its
     episode ends (so no autoreset runs with an unwanted seed); a sub-env left without an

@@ -25,8 +25,8 @@ import numpy as np
 
 import sgc_env
 from baselines.evaluation.episodes import EpisodeRecord, run_episode, run_episodes_batched
-from baselines.policies import Policy, make_policy, policy_label
-from sgc_env.envs.vector_env import make_vec
+from baselines.policies import Policy, make_policy, needs_planner_view, policy_label
+from sgc_env.envs.vector.vector_env import make_vec
 from sgc_env.metrics import Tolerances
 
 __all__ = [
@@ -313,7 +313,9 @@ def evaluate(
     :class:`~baselines.MinimumJerkController`; on the batched env it gets the vector env).
     ``keep_infos``: how many leading episodes keep their infos for plots. ``num_envs``: run
     on the batched env with ``min(num_envs, episodes)`` sub-envs (1: one single env). The env
-    is created here and closed at the end.
+    is created here and closed at the end; for a built-in policy that reads the planner's view
+    (:func:`~baselines.policies.needs_planner_view`) with ``observation="planner"`` (the same
+    scenes, dynamics and reward on the ids whose default is the learner's view).
     """
     sgc_env.check_env_id(env_id)
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
@@ -324,10 +326,13 @@ def evaluate(
         raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}")
     seed = int(seed)
     batched = min(num_envs, episodes) > 1
+    kwargs = dict(env_kwargs or {})
+    if isinstance(policy, str) and needs_planner_view(policy):
+        kwargs.setdefault("observation", "planner")
     env: Any = (
-        make_vec(env_id, min(num_envs, episodes), **dict(env_kwargs or {}))
+        make_vec(env_id, min(num_envs, episodes), **kwargs)
         if batched
-        else gym.make(env_id, **dict(env_kwargs or {}))
+        else gym.make(env_id, **kwargs)
     )
     try:
         probe = env.envs[0] if batched else env.unwrapped

@@ -10,7 +10,8 @@ trusted pickle as JSON once.
 
 Where the statistics of a model are (:func:`statistics_path`): ``<stem>.zip`` pairs with
 ``<stem>.vecnormalize.json`` beside it (shipped models), else ``vecnormalize.json`` in the
-same folder (``final_model.zip``/``best_model.zip``); a checkpoint
+same folder (``final_model.zip``/``best_model.zip``), else ``<stem>/vecnormalize.json`` (where
+rl-zoo3's trainer saves a run's statistics, as a pickle to convert once); a checkpoint
 ``<prefix>_<N>_steps.zip`` with ``<prefix>_vecnormalize_<N>_steps.json`` (SB3's
 ``CheckpointCallback`` names). The ``.pkl`` of the same name is found too, to be refused.
 """
@@ -49,7 +50,8 @@ def _candidates(model_path: str | Path) -> list[Path]:
     own = path.with_name(f"{path.stem}.vecnormalize")
     if checkpoint:
         return [own, path.with_name(f"{checkpoint[1]}_vecnormalize_{checkpoint[2]}_steps")]
-    return [own, path.with_name("vecnormalize")]
+    # rl-zoo3 writes <env id>.zip and <env id>/vecnormalize.pkl in the run folder
+    return [own, path.with_name("vecnormalize"), path.parent / path.stem / "vecnormalize"]
 
 
 def statistics_path(model_path: str | Path) -> Path | None:

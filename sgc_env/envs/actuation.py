@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from sgc_env.paper.quaternion import rotate, rotate_back
 from sgc_env.scenario import Scenario
 from sgc_env.simulator import BodyReading, Drive, Simulator
 
-__all__ = ["Actuation", "clip_action"]
+__all__ = ["Actuation", "body_drive", "clip_action"]
 
 
 def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
@@ -41,6 +42,33 @@ def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
     if math.isnan(sum(values)):
         raise ValueError(f"action contains non-finite values: {values}")
     return values
+
+
+def body_drive(
+    action: Sequence[Any], position: Sequence[Any], orientation: Sequence[Any],
+    velocity: Sequence[Any], force_limit: Any, torque_scale: Sequence[Any], mass: Any,
+    gravity: Sequence[float], coef: Sequence[tuple[float, float]],
+) -> tuple[tuple, tuple | None, list[tuple]]:  # fmt: skip
+    """One body's control period, the actuation rule of both envs (floats for one env, arrays
+    over sub-envs for the batched env): the force and torque (world frame) from its action
+    entries, force xyz then torque xyz (no torque for 3 entries), and its state at the step's
+    start; and the centre of mass before each substep under semi-implicit Euler,
+    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``), where
+    the force acts."""
+    fx, fy, fz = action[0] * force_limit, action[1] * force_limit, action[2] * force_limit
+    torque = None
+    if len(action) == 6:
+        sx, sy, sz = torque_scale
+        bx, by, bz = rotate_back(orientation, (action[3], action[4], action[5]))
+        torque = rotate(orientation, (bx * sx, by * sy, bz * sz))
+    gx, gy, gz = gravity
+    ax, ay, az = fx / mass + gx, fy / mass + gy, fz / mass + gz
+    x0, y0, z0 = position
+    vx, vy, vz = velocity
+    path = [
+        (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az) for kh, c in coef
+    ]
+    return (fx, fy, fz), torque, path
 
 
 class Actuation:
@@ -84,32 +112,19 @@ class Actuation:
         """The drives of one control period and the applied forces then torques (flat)."""
         use_torque = self.use_torque
         per = 6 if use_torque else 3
-        gx, gy, gz = self._gravity
-        coef = self._coef
+        gravity, coef = self._gravity, self._coef
         drives: list[Drive] = []
         applied_f: list[float] = []
         applied_t: list[float] = []
         for i, (pos, orn, lin, _) in enumerate(states):
-            fl = self._flimit[i]
             o = i * per
-            fx, fy, fz = values[o] * fl, values[o + 1] * fl, values[o + 2] * fl
-            f = (fx, fy, fz)
+            f, tq, path = body_drive(
+                values[o : o + per], pos, orn, lin, self._flimit[i], self._tscale[i],
+                self._mass[i], gravity, coef,
+            )  # fmt: skip
             applied_f += f
-            tq = None
-            if use_torque:
-                sx, sy, sz = self._tscale[i]
-                bx, by, bz = rotate_back(orn, (values[o + 3], values[o + 4], values[o + 5]))
-                tq = rotate(orn, (bx * sx, by * sy, bz * sz))
+            if tq is not None:
                 applied_t += tq
-            m = self._mass[i]
-            ax, ay, az = fx / m + gx, fy / m + gy, fz / m + gz
-            x0, y0, z0 = pos
-            vx, vy, vz = lin
-            # Semi-implicit Euler: the CoM before substep k is x + k h v + h^2 a k (k + 1) / 2.
-            path = [
-                (x0 + kh * vx + c * ax, y0 + kh * vy + c * ay, z0 + kh * vz + c * az)
-                for kh, c in coef
-            ]
             drives.append((self._uids[i], f, tq, path))
         return drives, applied_f + (applied_t or self._zeros3n)
 

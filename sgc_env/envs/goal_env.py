@@ -48,7 +48,7 @@ class SGCGoalEnv(SGCEnv):
             raise ValueError("the goal-conditioned env needs a position track on body 0")
         self.tolerance = float(tolerance)
         box = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (4,), np.float32)
-        flat = gym.spaces.Box(-OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32)
+        flat = self.observation_space  # the view's
         self.observation_space = gym.spaces.Dict(
             {
                 "observation": flat,

@@ -16,7 +16,7 @@ from sgc_env.scenario import Scenario, load_scenario
 
 from .props import PropPaths
 from .task import GoalTask
-from .world import SharedWorld
+from .vector.world import SharedWorld
 
 __all__ = ["Prepared", "as_scenario", "prepare_scenario", "scene_geometry"]
 

@@ -1,4 +1,11 @@
-"""The env's reward modes: one :class:`~sgc_env.envs.task.RewardFunction` per mode.
+"""The env's reward modes: one :class:`RewardMode` class per mode, each with one method.
+
+A mode's :meth:`RewardMode.reward` scores a :class:`StepScore`, the same for one env (floats)
+and for the batched env (arrays over sub-envs): its arithmetic is elementwise and its branches
+go through :mod:`sgc_env.paper.elementwise`, so both envs run this code and agree bit for bit.
+``gym.make(id, reward=...)`` and ``gym.make_vec(id, n, reward=...)`` take a mode's name
+(:data:`REWARD_MODES`) or a :class:`RewardMode` instance, a mode of the caller's own. Adding a
+mode is one subclass here, registered by :func:`reward_mode`.
 
 Every mode reads what the observation carries (per body and track: the deviation ``D``, the
 time left, the course's start deviation ``D_i(0)`` and duration ``T_i``, the end velocity after
@@ -41,27 +48,43 @@ per-track cost capped at 1 no state is worse than that. ``distance`` keeps its o
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sgc_env.paper.elementwise import any_, at_least, at_most, sqrt, where
+
+from .choices import choose
 
 if TYPE_CHECKING:
-    from .task import GoalEvent, GoalTask, RewardFunction
+    from .task import GoalEvent, GoalTask
 
 __all__ = [
     "EFFORT_WEIGHT",
     "REWARD_MODES",
     "DistanceReward",
+    "RewardMode",
     "ScheduleReward",
     "SparseReward",
-    "TrackState",
+    "StepScore",
+    "TrackingReward",
+    "TrackReading",
     "distance_cost",
+    "effort",
+    "failure_charge",
     "goal_bonus",
     "make_reward",
+    "reward_mode",
     "schedule_cost",
+    "schedule_error",
+    "square_sum",
+    "track_costs",
+    "tracking_score",
     "tracks_of",
 ]
 
-REWARD_MODES: tuple[str, ...] = ("schedule", "distance", "sparse")
 EFFORT_WEIGHT = 0.01
 POSITION_FLOOR = 0.1  # m
 ORIENTATION_FLOOR = 0.5  # rad
@@ -69,18 +92,60 @@ TRACK_COST_CAP = 1.0
 BONUS_POSITION = 0.01  # m
 BONUS_ORIENTATION = 0.02  # rad
 
-TrackState = tuple[Sequence[float], float, Sequence[float]]
-"""One track of one body after a step: deviation (D or phi, first 3 entries read), time left
-to the current goal, and the course's 13 observation entries (start deviation 3, duration 1,
-next start 3, next duration 1, end velocity 3, flags: has a track, is the last goal)."""
+TrackReading = tuple[Any, Sequence[Any], Any, Sequence[Any], float]
+"""One track of one body after a step: whether the body has it (a bool, or one per sub-env),
+its deviation (D or phi, first 3 entries read), the time left to the current goal, the course's
+13 observation entries (start deviation 3, duration 1, next start 3, next duration 1, end
+velocity 3, flags: has a track, is the last goal) and the floor of its scale (m or rad)."""
 
 
-def _effort(action: Sequence[float]) -> float:
-    return EFFORT_WEIGHT * sum([x * x for x in action]) / len(action)
+class StepScore:
+    """What a reward mode scores after a step, for one env (floats) or N sub-envs (arrays):
+    every track of every body in body order, position first (:data:`TrackReading`), the
+    number of bodies, the clipped action's sum of squares and size, the goal bonuses of the
+    tick, the failure flag and the steps the episode had left."""
+
+    __slots__ = ("action_size", "bonus", "failed", "n_bodies", "square_sum", "steps_left", "tracks")
+
+    def __init__(
+        self, tracks: list[TrackReading], n_bodies: int, square_sum: Any, action_size: int,
+        bonus: Any, failed: Any, steps_left: Any,
+    ) -> None:  # fmt: skip
+        self.tracks = tracks
+        self.n_bodies = n_bodies
+        self.square_sum = square_sum
+        self.action_size = action_size
+        self.bonus = bonus
+        self.failed = failed
+        self.steps_left = steps_left
+
+
+class RewardMode:
+    """A reward mode: :meth:`reward` of a :class:`StepScore` (module docstring). Subclasses
+    write it with elementwise arithmetic and :mod:`sgc_env.paper.elementwise`'s branches so
+    that one env and the batched env score alike; a mode keeps no state between steps."""
+
+    name = "custom"
+
+    def reward(self, step: StepScore) -> Any:
+        """The step's reward: a float for one env, one per sub-env for the batched env."""
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+REWARD_CLASSES: dict[str, type[RewardMode]] = {}
+
+
+def reward_mode(cls: type[RewardMode]) -> type[RewardMode]:
+    """Register a mode under its ``name`` (the ``reward=`` string that picks it)."""
+    REWARD_CLASSES[cls.name] = cls
+    return cls
 
 
 def goal_bonus(events: Sequence[GoalEvent]) -> float:
-    """The bonuses of the goals met this tick (the module docstring; the batched env's too)."""
+    """The bonuses of the goals met this tick (the module docstring)."""
     total = 0.0
     for ev in events:
         if ev["position_error"] is not None:
@@ -90,97 +155,166 @@ def goal_bonus(events: Sequence[GoalEvent]) -> float:
     return total
 
 
-def _norm(v: Sequence[float]) -> float:
-    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+def effort(step: StepScore) -> Any:
+    """``0.01 mean(a^2)``, the effort term of every mode."""
+    return EFFORT_WEIGHT * step.square_sum / step.action_size
 
 
-def schedule_cost(track: TrackState, floor: float) -> float:
-    """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
-    d, left, c = track
-    if left >= 0.0:
+def schedule_error(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``|D - D_sched| / L`` (see the module docstring), uncapped."""
+    ahead = left >= 0.0
+    if ahead is True or ahead is not False and ahead.all():  # all_ inline: see elementwise
         f = left / c[3]
         rx, ry, rz = c[0] * f, c[1] * f, c[2] * f
-    else:
+    elif not any_(ahead):
         rx, ry, rz = -c[8] * left, -c[9] * left, -c[10] * left
-    error = _norm((d[0] - rx, d[1] - ry, d[2] - rz))
-    return min(error / max(_norm(c), floor), TRACK_COST_CAP)
+    else:
+        f = left / c[3]
+        rx = where(ahead, c[0] * f, -c[8] * left)
+        ry = where(ahead, c[1] * f, -c[9] * left)
+        rz = where(ahead, c[2] * f, -c[10] * left)
+    ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
+    scale = at_least(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
+    return sqrt(ex * ex + ey * ey + ez * ez) / scale
 
 
-def distance_cost(track: TrackState, floor: float) -> float:
+def schedule_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``min(|D - D_sched| / L, 1)`` (see the module docstring)."""
+    return at_most(schedule_error(d, left, c, floor), TRACK_COST_CAP)
+
+
+def tracking_score(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
+    """``1 / (1 + |D - D_sched| / L)``: 1 on the schedule, falling at every distance."""
+    return 1.0 / (1.0 + schedule_error(d, left, c, floor))
+
+
+def distance_cost(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
     """``|D| / L`` (uncapped)."""
-    d, _, c = track
-    return _norm(d) / max(_norm(c), floor)
+    scale = at_least(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
+    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) / scale
 
 
-def tracks_of(task: GoalTask) -> list[tuple[TrackState, float]]:
-    """Every track of every body with the floor of its scale (m for position, rad)."""
-    out: list[tuple[TrackState, float]] = []
+def tracks_of(task: GoalTask) -> list[TrackReading]:
+    """The tracks of one env's task (every body's it has, position first)."""
+    out: list[TrackReading] = []
     for i in range(task.n_bodies):
         if task.has_position[i]:
-            track: TrackState = (
-                task.deviations[i], task.position_time_left[i], task.position_course[i]
-            )
-            out.append((track, POSITION_FLOOR))
+            out.append(
+                (True, task.deviations[i], task.position_time_left[i], task.position_course[i],
+                 POSITION_FLOOR)
+            )  # fmt: skip
         if task.has_orientation[i]:
-            track = (task.phi[i], task.orientation_time_left[i], task.orientation_course[i])
-            out.append((track, ORIENTATION_FLOOR))
+            out.append(
+                (True, task.phi[i], task.orientation_time_left[i], task.orientation_course[i],
+                 ORIENTATION_FLOOR)
+            )  # fmt: skip
     return out
 
 
-class _ModeReward:
-    """``-mean_b sum_tracks cost - effort + bonus``, and on a failure the steps left charged at
-    the worst per-step reward (where the mode charges failures; its costs must then be capped
-    at :data:`TRACK_COST_CAP`)."""
+_SEQUENTIAL_SUM = sys.version_info < (3, 12)  # 3.12's sum() of floats is compensated
 
-    def __init__(self, cost: Callable[[TrackState, float], float] | None, charge: bool) -> None:
-        self._cost = cost
-        self._charge = charge
 
-    def __call__(
-        self,
-        task: GoalTask,
-        action: Sequence[float],
-        events: Sequence[GoalEvent],
-        terminated: bool = False,
-        steps_left: int = 0,
-    ) -> float:
-        cost = worst = 0.0
-        if self._cost is not None:
-            for track, floor in tracks_of(task):
-                cost += self._cost(track, floor)
-                worst += TRACK_COST_CAP
-        n = task.n_bodies
-        reward = -cost / n - _effort(action) + goal_bonus(events)
-        if terminated and self._charge:
-            reward -= (worst / n + EFFORT_WEIGHT) * steps_left
+def square_sum(action: Any) -> Any:
+    """``sum(x * x for x in action)`` of one action (floats), or of each row of an (N, size)
+    array, summed as Python's ``sum`` does (left to right before 3.12)."""
+    if not isinstance(action, np.ndarray):
+        return sum([x * x for x in action])
+    squares = action * action
+    if _SEQUENTIAL_SUM:
+        total = squares[:, 0].copy()
+        for k in range(1, squares.shape[1]):
+            total += squares[:, k]
+        return total
+    return np.array([sum(row) for row in squares.tolist()])
+
+
+def track_costs(
+    step: StepScore, cost: Callable[[Sequence[Any], Any, Sequence[Any], float], Any]
+) -> tuple[Any, Any]:
+    """The sum of ``cost`` over the tracks a body has, in track order, and the sum of the cap
+    over them (the worst the costs can be, when ``cost`` is capped)."""
+    total: Any = 0.0
+    worst: Any = 0.0
+    for has, d, left, course, floor in step.tracks:
+        if has is False or has is not True and not has.any():  # any_ inline: see elementwise
+            continue
+        value = cost(d, left, course, floor)
+        if has is True or has.all():
+            total, worst = total + value, worst + TRACK_COST_CAP
+        else:
+            total = where(has, total + value, total)
+            worst = where(has, worst + TRACK_COST_CAP, worst)
+    return total, worst
+
+
+def failure_charge(step: StepScore, reward: Any, worst: Any) -> Any:
+    """``reward`` less, on a failure, every step left at the worst per-step reward
+    (``worst / bodies + 0.01``)."""
+    failed = step.failed
+    if failed is False or failed is not True and not failed.any():  # any_ inline
         return reward
+    return where(
+        step.failed, reward - (worst / step.n_bodies + EFFORT_WEIGHT) * step.steps_left, reward
+    )
 
 
-class ScheduleReward(_ModeReward):
+@reward_mode
+class ScheduleReward(RewardMode):
     """The default: distance from the on-schedule deviation (capped), effort, bonuses, and the
     failure charge."""
 
-    def __init__(self) -> None:
-        super().__init__(schedule_cost, charge=True)
+    name = "schedule"
+
+    def reward(self, step: StepScore) -> Any:
+        cost, worst = track_costs(step, schedule_cost)
+        return failure_charge(step, -cost / step.n_bodies - effort(step) + step.bonus, worst)
 
 
-class DistanceReward(_ModeReward):
+@reward_mode
+class DistanceReward(RewardMode):
     """The reward before the modes: ``|D| / L`` per track, effort, bonuses, no failure charge."""
 
-    def __init__(self) -> None:
-        super().__init__(distance_cost, charge=False)
+    name = "distance"
+
+    def reward(self, step: StepScore) -> Any:
+        cost, _ = track_costs(step, distance_cost)
+        return -cost / step.n_bodies - effort(step) + step.bonus
 
 
-class SparseReward(_ModeReward):
+@reward_mode
+class SparseReward(RewardMode):
     """Goal-tick bonuses and effort only; a failure charges the worst effort per step left."""
 
-    def __init__(self) -> None:
-        super().__init__(None, charge=True)
+    name = "sparse"
+
+    def reward(self, step: StepScore) -> Any:
+        return failure_charge(step, -0.0 / step.n_bodies - effort(step) + step.bonus, 0.0)
 
 
-def make_reward(mode: str) -> RewardFunction:
-    """The reward function of ``mode`` (one of :data:`REWARD_MODES`)."""
-    modes = {"schedule": ScheduleReward, "distance": DistanceReward, "sparse": SparseReward}
-    if mode not in modes:
-        raise ValueError(f"reward: unknown mode {mode!r}; expected one of {list(REWARD_MODES)}")
-    return modes[mode]()
+@reward_mode
+class TrackingReward(RewardMode):
+    """The default of the ids' newest versions: ``mean_b sum_tracks 1 / (1 + x)`` with ``x =
+    |D - D_sched| / L``, plus ``0.01 (1 - mean(a^2))`` and the goal bonuses; no failure charge.
+
+    The same on-schedule error as ``schedule``, paid in a form a learner can climb: every step
+    alive earns between 0 and the number of tracks, so leaving the workspace loses what the
+    rest of the episode would have paid (no lump charge that a value function has to predict),
+    and ``1 / (1 + x)`` falls at every distance (``schedule``'s ``min(x, 1)`` is flat beyond a
+    course length, where an untrained body spends its first episodes). Undiscounted, it ranks
+    policies that finish the episode as ``schedule`` does, up to a constant per scenario.
+    """
+
+    name = "tracking"
+
+    def reward(self, step: StepScore) -> Any:
+        score, _ = track_costs(step, tracking_score)
+        return score / step.n_bodies + EFFORT_WEIGHT - effort(step) + step.bonus
+
+
+REWARD_MODES: tuple[str, ...] = tuple(REWARD_CLASSES)
+
+
+def make_reward(mode: object) -> RewardMode:
+    """The mode ``mode`` names (one of :data:`REWARD_MODES`), or ``mode`` itself when it is a
+    :class:`RewardMode`."""
+    return choose("reward", "mode", mode, REWARD_CLASSES, RewardMode)

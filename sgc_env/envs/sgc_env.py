@@ -99,9 +99,11 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
 :class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
 ``reward`` (``"schedule"``, ``"distance"`` or
-``"sparse"``, above). ``reset(options={"scenario": ...})`` swaps the
-scenario (same number of bodies and action size; a random-scenario env draws again on the next
-plain reset).
+``"sparse"``, above, or any :class:`~sgc_env.envs.rewards.RewardMode` instance),
+``observation`` (``"planner"``, the layout above, or any
+:class:`~sgc_env.envs.views.ObservationView` instance). ``reset(options={"scenario": ...})``
+swaps the scenario (same number of bodies and action size; a random-scenario env draws again
+on the next plain reset).
 """
 
 from __future__ import annotations
@@ -116,7 +118,7 @@ import gymnasium as gym
 import numpy as np
 
 from sgc_env.episode_steps import check_registered_length
-from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout, float32_residuals
+from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
 from sgc_env.render.camera import View
 from sgc_env.render.modes import available_render_modes
 from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
@@ -126,18 +128,17 @@ from sgc_env.scenes import random_scenario as draw_random_scenario
 from sgc_env.simulator import Drive, Simulator
 
 from .actuation import Actuation, clip_action
+from .failure import MAX_SPEED, SPIN_CLAMP, body_flags
 from .prepare import Prepared, as_scenario, prepare_scenario, scene_geometry
-from .rewards import make_reward
+from .record import body_block
+from .rewards import RewardMode, StepScore, goal_bonus, make_reward, square_sum, tracks_of
 from .snapshots import SavedState
 from .step_info import StepInfo, step_info
-from .task import GoalEvent, RewardFunction, TaskCounters
-from .world import SharedWorld
+from .task import GoalEvent, TaskCounters
+from .vector.world import SharedWorld
+from .views import OBS_BOUND, ObservationView, make_view
 
-__all__ = ["SGCEnv", "SavedState", "StepInfo"]
-
-OBS_BOUND = 1e5
-MAX_SPEED = 90.0  # m/s; PyBullet clamps linear speed at 100
-SPIN_CLAMP = 99.0  # rad/s; PyBullet clamps |omega| at 100: reported, not terminal
+__all__ = ["MAX_SPEED", "OBS_BOUND", "SPIN_CLAMP", "SGCEnv", "SavedState", "StepInfo"]
 
 
 class SGCEnv(gym.Env):
@@ -157,17 +158,20 @@ class SGCEnv(gym.Env):
         camera: str | dict[str, Any] | None = None,
         width: int = 640,
         height: int = 480,
-        reward: str = "schedule",
+        reward: str | RewardMode = "schedule",
+        observation: str | ObservationView = "planner",
         world: SharedWorld | None = None,
     ) -> None:
         self._init_kwargs: dict[str, Any] = {
             "scenario": scenario, "random_scenario": random_scenario,
             "control_frequency": control_frequency, "sim_frequency": sim_frequency,
             "time_grid": time_grid, "render_mode": render_mode, "camera": camera,
-            "width": width, "height": height, "reward": reward,
+            "width": width, "height": height, "reward": reward, "observation": observation,
         }  # fmt: skip
         self.reward_mode = reward
-        self._reward: RewardFunction = make_reward(reward)
+        self._reward = make_reward(reward)
+        self._score = StepScore([], 1, 0.0, 1, 0.0, False, 0)  # filled every step
+        self._view = make_view(observation)
         if render_mode is not None and render_mode not in type(self).metadata["render_modes"]:
             raise ValueError(f"render_mode must be 'human' or 'rgb_array', got {render_mode!r}")
         if scenario is None and random_scenario is None:
@@ -210,6 +214,7 @@ class SGCEnv(gym.Env):
             "render_modes": available_render_modes(),
         }
         self._n = len(base.bodies)
+        self._score.n_bodies = self._n
         self.use_torque = not all(
             b.shape == "sphere" and not b.has_orientation_track for b in base.bodies
         )
@@ -217,13 +222,12 @@ class SGCEnv(gym.Env):
         self.action_space = gym.spaces.Box(-1.0, 1.0, (per * self._n,), np.float32)
         self._action_shape = self.action_space.shape
         self.layout = ObservationLayout(self._n, tuple(b.name for b in base.bodies))
-        self._obs_size = self.layout.size
-        # The observation's doubles (residual slots hold residuals), then point positions,
-        # forces and torques: packed into one buffer per step (see _observe).
+        self._block_end = self.layout.size
+        # The step record (planner blocks, residual slots holding residuals, the time, then
+        # point positions, forces and torques: sgc_env.envs.record), packed once per step.
         self._record = struct.Struct(f"{self.layout.size + 9 * self._n}d")
-        self.observation_space = gym.spaces.Box(
-            -OBS_BOUND, OBS_BOUND, (self.layout.size,), np.float32
-        )
+        self._view = self._view.bind(self.layout)
+        self.observation_space = self._view.space()
         self._renderer: SceneRenderer | None = None
         self._closed = False
         self.scenario: Scenario = base
@@ -311,10 +315,17 @@ class SGCEnv(gym.Env):
             substeps=self.substeps, sim_frequency=self.sim_frequency,
         )  # fmt: skip
         self.torque_scale = self._actuation.torque_scale
+        self._view_constants = self._view.constants(self)
         self._ws_low, self._ws_high = (
             tuple(map(float, s.workspace[0])),
             tuple(map(float, s.workspace[1])),
         )
+
+    @property
+    def observation_view(self) -> str:
+        """The name of the view this env observes (``"planner"``, ``"learner"``, or a custom
+        view's ``name``)."""
+        return self._view.name
 
     # ---------------------------------------------------------------- reset / step
 
@@ -354,12 +365,14 @@ class SGCEnv(gym.Env):
         self._observe()
 
     def _observe(self, read: bool = True) -> None:
-        """Read every body once, let the task measure it, and build the observation.
+        """Read every body once, let the task measure it, and build the step record, the
+        observation and the failure and spin-clamp flags (the rules of :mod:`.record`,
+        :mod:`.failure` and the view, which the batched env runs on arrays).
 
         Pure-Python arithmetic on tuples, one struct pack into a fresh buffer and one cast:
         for a few bodies that is several times cheaper than numpy calls on 3-vectors.
         ``read=False`` rebuilds from the last read (after a goal switch) without calling
-        PyBullet again. Also sets the failure and spin-clamp flags.
+        PyBullet again.
         """
         if read:
             self._states = self.sim.body_states(self._uids)
@@ -372,28 +385,16 @@ class SGCEnv(gym.Env):
         pcourse, ocourse = task.position_course, task.orientation_course
         flat: list[float] = []
         ok = True
-        spin = 0.0
+        spin = False
         lo, hi = self._ws_low, self._ws_high
-        for i, (pos, orn, lin, ang) in enumerate(self._states):
-            dev, phi, ptl, otl = devs[i], phis[i], ptls[i], otls[i]
-            # The residual slots follow in RESIDUAL_FIELDS order (pinned by a test); the point
-            # offset's is cached with the goal.
-            flat += [
-                *pos, *orn, *lin, *ang, *offsets[i], *dev, ptl, *pcourse[i], *phi, otl,
-                *ocourse[i], *float32_residuals((*dev, *orn, *ang, *lin, *phi, ptl, otl)),
-                *residuals[i],
-            ]  # fmt: skip
-            wx, wy, wz = ang
-            spin = max(spin, wx * wx + wy * wy + wz * wz)
-            if ok:
-                vx, vy, vz = lin
-                # NaN fails every comparison, so this also catches non-finite states; with the
-                # workspace inside +-1e4 it keeps the observation inside its bounds.
-                ok = (
-                    lo[0] < pos[0] < hi[0] and lo[1] < pos[1] < hi[1] and lo[2] < pos[2] < hi[2]
-                    and vx * vx + vy * vy + vz * vz < MAX_SPEED**2
-                    and spin == spin
-                )  # fmt: skip
+        for i, state in enumerate(self._states):
+            flat += body_block(
+                state, offsets[i], devs[i], ptls[i], pcourse[i], phis[i], otls[i], ocourse[i],
+                residuals[i],
+            )  # fmt: skip
+            fine, clamped = body_flags(state, lo, hi)
+            ok = ok and fine
+            spin = spin or clamped
         flat.append(t)
         for p in task.points:
             flat += p
@@ -403,12 +404,12 @@ class SGCEnv(gym.Env):
         buffer = bytearray(self._record.size)
         self._record.pack_into(buffer, 0, *flat)
         arr = np.frombuffer(buffer)
-        size = self._obs_size
-        self._obs = arr[:size].astype(np.float32)
+        size = self._block_end
+        self._obs = self._view.observe(arr, self._view_constants)
         self._block = arr[: size - 1].reshape(self._n, BODY_BLOCK_SIZE)
         self._tail = arr[size:].reshape(3, self._n, 3)
         self._failed = not ok
-        self._spin_clamped = spin >= SPIN_CLAMP**2
+        self._spin_clamped = spin
 
     def step(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
         self, action: np.ndarray
@@ -422,11 +423,11 @@ class SGCEnv(gym.Env):
 
     def _drives(
         self, values: list[float]
-    ) -> tuple[list[Drive], list[list[tuple[int, tuple[float, ...]]]]]:
+    ) -> tuple[list[Drive], list[list[tuple[int, list[float]]]]]:
         """The bodies' drives and the props' moves (one list per substep) of the next control
         period; the batched env gathers these from every sub-env into one physics step."""
         drives, self._applied = self._actuation.drives(values, self._states)
-        moves: list[list[tuple[int, tuple[float, ...]]]] = []
+        moves: list[list[tuple[int, list[float]]]] = []
         if self._prop_uids:
             base = self._tick * self.substeps
             at = self._props.at
@@ -447,8 +448,11 @@ class SGCEnv(gym.Env):
             if changed:
                 self._observe(read=False)
         terminated = self._failed
-        steps_left = self.max_steps - self._tick
-        reward = self._reward(task, values, events, terminated, steps_left)
+        score = self._score  # one per env, refilled: the mode reads it during this call only
+        score.tracks, score.square_sum = tracks_of(task), square_sum(values)
+        score.action_size, score.bonus = len(values), goal_bonus(events)
+        score.failed, score.steps_left = terminated, self.max_steps - self._tick
+        reward = self._reward.reward(score)
         truncated = (not terminated) and self._tick >= self.max_steps
         info = self._info(events)
         if self.render_mode == "human":

@@ -6,28 +6,66 @@ record is a fresh buffer every step, so infos handed out earlier keep their valu
 
 from __future__ import annotations
 
-from typing import TypedDict
+from typing import Any, TypedDict, cast
 
 import numpy as np
 
-from sgc_env.observation import ObservationLayout
+from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
 
 from .task import GoalEvent, GoalTask
 
-__all__ = ["StepInfo", "step_info"]
+__all__ = ["INFO_ARRAYS", "StepInfo", "info_arrays", "step_info"]
 
-# Per-body columns of the (bodies, block) record that info hands out as views; built once
+# Per-body columns of the (..., bodies, block) record that infos hand out as views; built once
 # because constructing the index tuples costs as much as the slicing itself.
 _BLOCK = ObservationLayout(1)
-_COL_DEV = np.s_[:, _BLOCK.body_slice(0, "position_deviation")]
-_COL_POINT_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "point_velocity")]
-_COL_ODEV = np.s_[:, _BLOCK.body_slice(0, "orientation_deviation")]
-_COL_PTL = np.s_[:, _BLOCK.body_slice(0, "position_time_left").start]
-_COL_OTL = np.s_[:, _BLOCK.body_slice(0, "orientation_time_left").start]
-_COL_POSITION = np.s_[:, _BLOCK.body_slice(0, "position")]
-_COL_ORIENTATION = np.s_[:, _BLOCK.body_slice(0, "orientation")]
-_COL_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "linear_velocity")]
-_COL_ANGULAR_VELOCITY = np.s_[:, _BLOCK.body_slice(0, "angular_velocity")]
+
+
+def _columns(name: str) -> tuple[Any, ...]:
+    cols = _BLOCK.body_slice(0, name)
+    return np.s_[..., cols] if cols.stop - cols.start > 1 else np.s_[..., cols.start]
+
+
+_DEV, _ODEV = _columns("position_deviation"), _columns("orientation_deviation")
+_PTL, _OTL = _columns("position_time_left"), _columns("orientation_time_left")
+_POSITION, _ORIENTATION = _columns("position"), _columns("orientation")
+_VELOCITY, _ANGULAR = _columns("linear_velocity"), _columns("angular_velocity")
+_POINT_VELOCITY = _columns("point_velocity")
+
+
+def info_arrays(
+    time: Any, block: np.ndarray, tail: np.ndarray, goal_index: np.ndarray,
+    orientation_goal_index: np.ndarray, spin_clamped: Any,
+) -> dict[str, Any]:  # fmt: skip
+    """The info's every-step entries in order, the per-body arrays views of a step record:
+    ``block`` (..., bodies, block) and ``tail`` (3, ..., bodies, 3: points, forces, torques),
+    where ``...`` is nothing for one env and the sub-envs for the batched env (one rule for
+    both). The goal indices are handed out as given (copies: infos share no object)."""
+    return {
+        "time": time,
+        "goal_index": goal_index,
+        "orientation_goal_index": orientation_goal_index,
+        "position_deviation": block[_DEV],
+        "orientation_deviation": block[_ODEV],
+        "time_to_goal": block[_PTL],
+        "orientation_time_to_goal": block[_OTL],
+        "body_position": block[_POSITION],
+        "body_orientation": block[_ORIENTATION],
+        "body_velocity": block[_VELOCITY],
+        "body_angular_velocity": block[_ANGULAR],
+        "point_position": tail[0],
+        "point_velocity": block[_POINT_VELOCITY],
+        "force": tail[1],
+        "torque": tail[2],
+        "spin_clamped": spin_clamped,
+    }
+
+
+INFO_ARRAYS = tuple(
+    info_arrays(0.0, np.zeros((1, BODY_BLOCK_SIZE)), np.zeros((3, 1, 3)), np.zeros(1),
+                np.zeros(1), False)
+)[1:-1]  # fmt: skip
+"""The info's per-body array keys in order (``time`` comes first, ``spin_clamped`` last)."""
 
 
 class _StepInfoEveryStep(TypedDict):
@@ -67,24 +105,13 @@ def step_info(
 ) -> StepInfo:
     """The info of one step from its record: ``block`` (bodies, block) and ``tail`` (point
     positions, forces, torques: 3, bodies, 3)."""
-    info: StepInfo = {
-        "time": time,
-        "goal_index": task.goal_index.copy(),
-        "orientation_goal_index": task.orientation_goal_index.copy(),
-        "position_deviation": block[_COL_DEV],
-        "orientation_deviation": block[_COL_ODEV],
-        "time_to_goal": block[_COL_PTL],
-        "orientation_time_to_goal": block[_COL_OTL],
-        "body_position": block[_COL_POSITION],
-        "body_orientation": block[_COL_ORIENTATION],
-        "body_velocity": block[_COL_VELOCITY],
-        "body_angular_velocity": block[_COL_ANGULAR_VELOCITY],
-        "point_position": tail[0],
-        "point_velocity": block[_COL_POINT_VELOCITY],
-        "force": tail[1],
-        "torque": tail[2],
-        "spin_clamped": spin_clamped,
-    }
+    info = cast(
+        StepInfo,
+        info_arrays(
+            time, block, tail, task.goal_index.copy(), task.orientation_goal_index.copy(),
+            spin_clamped,
+        ),
+    )
     if events:
         info["goal_reached"] = events
     return info

@@ -5,41 +5,38 @@ this :class:`GoalTask` judges them against the scenario's goals, and
 :class:`~sgc_env.envs.sgc_env.SGCEnv` joins the two with the observation layout. The task owns
 the compiled tracks, the current goal of every track, the deviations D, D' and the unwrapped
 rotation deviation phi, the goal events of a tick and the goal-conditioned view (achieved and
-desired goal) that HER relabels. It defines the :class:`RewardFunction` seam but picks no
-reward: the env calls its mode (:mod:`sgc_env.envs.rewards`, which imports this module, never
-the other way) with the task. It never calls PyBullet: it is handed the bodies' states.
+desired goal) that HER relabels. It picks no reward (the env scores its mode,
+:mod:`sgc_env.envs.rewards`) and never calls PyBullet: it is handed the bodies' states.
 
-The per-step methods work on Python tuples, not numpy: for a few bodies that is several times
-cheaper (the env's step cost is measured in ``scripts/bench_env.py``).
+The per-step work is the measurement rule (:mod:`.measure`) on Python tuples, not numpy: for a
+few bodies that is several times cheaper (``scripts/bench_env.py``). The batched env runs the
+same rule on arrays over its sub-envs and moves a sub-env to its next goals with this class's
+:meth:`GoalTask.advance` (goal ticks are rare).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Protocol, TypedDict
+from typing import TypedDict
 
 import numpy as np
 
 from sgc_env.observation import float32_residuals
-from sgc_env.paper.quaternion import log as rotvec_from_quat
-from sgc_env.paper.quaternion import mul_conjugate as quat_conj_mul
-from sgc_env.paper.quaternion import rotate, unwrap_rotvec
 from sgc_env.scenario import Scenario
 from sgc_env.simulator import BodyReading
 
+from .measure import measure
 from .tracks import BodyTracks, Track, compile_tracks
 
 __all__ = [
     "BodyReading",
     "GoalEvent",
     "GoalTask",
-    "RewardFunction",
     "TaskCounters",
 ]
 
 _ZERO3 = (0.0, 0.0, 0.0)
-_ZERO6 = (0.0,) * 6
 _ZERO13 = (0.0,) * 13
 
 
@@ -60,22 +57,6 @@ class TaskCounters(TypedDict):
     pos_idx: list[int]
     ori_idx: list[int]
     phi: list[list[float]]
-
-
-class RewardFunction(Protocol):
-    """The reward of one control step, from the task after the step (its deviations, current
-    courses and tracks), the clipped action values and the goal events of the step; on a failure
-    (``terminated``) also the number of steps the episode had left, so a mode can charge them
-    (the modes, :class:`DistanceReward` among them: :mod:`sgc_env.envs.rewards`)."""
-
-    def __call__(
-        self,
-        task: GoalTask,
-        action: Sequence[float],
-        events: Sequence[GoalEvent],
-        terminated: bool = False,
-        steps_left: int = 0,
-    ) -> float: ...
 
 
 def rotation_angle(phi: Sequence[float]) -> float:
@@ -107,8 +88,8 @@ class GoalTask:
     """Goal tracking of every body of one resolved scenario (see the module docstring).
 
     Per step the env calls :meth:`measure` with the bodies' states, then :meth:`advance` on a
-    tick where a goal falls (:attr:`next_event`), then its :class:`RewardFunction` with this
-    task (the env owns the reward: this module never picks one). After
+    tick where a goal falls (:attr:`next_event`), then scores its reward mode on this task's
+    tracks (the env owns the reward: this module never picks one). After
     :meth:`measure` the public lists hold, per body: :attr:`points` (world position of the
     tracked point), :attr:`deviations` (D and D', zeros without a position track), :attr:`phi`
     (unwrapped rotation deviation), :attr:`position_time_left`, :attr:`orientation_time_left`.
@@ -122,6 +103,7 @@ class GoalTask:
         self.has_orientation = [bt.orientation is not None for bt in self.tracks]
         n = self.n_bodies
         self.offsets: list[tuple[float, ...]] = [_ZERO3] * n
+        self.has_offset = [False] * n
         self.offset_residuals: list[list[float]] = [[0.0, 0.0, 0.0]] * n
         self.nails: list[tuple[float, ...]] = [_ZERO3] * n
         self.goal_quaternions: list[tuple[float, ...]] = [(0.0, 0.0, 0.0, 1.0)] * n
@@ -176,6 +158,7 @@ class GoalTask:
         if tr is not None:
             k = self.pos_idx[i]
             self.offsets[i] = tuple(tr.points[k].tolist())
+            self.has_offset[i] = self.offsets[i] != _ZERO3
             self.offset_residuals[i] = float32_residuals(self.offsets[i])
             self.nails[i] = tuple(tr.targets[k].tolist())
             self.position_goal_time[i] = float(tr.times[k])
@@ -183,6 +166,7 @@ class GoalTask:
             self.goal_index = _with(self.goal_index, i, int(tr.goal_ids[k]))
         else:
             self.offsets[i] = _ZERO3
+            self.has_offset[i] = False
             self.offset_residuals[i] = [0.0, 0.0, 0.0]
             self.position_course[i] = _ZERO13
         to = self.tracks[i].orientation
@@ -209,8 +193,9 @@ class GoalTask:
     # ---------------------------------------------------------------- per step
 
     def measure(self, states: Sequence[BodyReading], time: float) -> None:
-        """Deviations of every body from its current goals at ``time`` (see the class)."""
-        offsets, nails, phis = self.offsets, self.nails, self.phi
+        """Deviations of every body from its current goals at ``time`` (see the class), by the
+        measurement rule of both envs (:func:`sgc_env.envs.measure.measure`)."""
+        offsets, has_offset, nails, phis = self.offsets, self.has_offset, self.nails, self.phi
         has_pos, has_ori = self.has_position, self.has_orientation
         ptime, otime, goal_q = (
             self.position_goal_time,
@@ -218,37 +203,18 @@ class GoalTask:
             self.goal_quaternions,
         )
         points = []
-        deviations: list[tuple[float, ...]] = []
+        deviations = []
         ptls = []
         otls = []
-        for i, (pos, orn, lin, ang) in enumerate(states):
-            offset = offsets[i]
-            if offset == _ZERO3:
-                r, p = offset, pos
-            else:
-                r = rotate(orn, offset)
-                p = (pos[0] + r[0], pos[1] + r[1], pos[2] + r[2])
-            points.append(p)
-            if has_pos[i]:
-                nail = nails[i]
-                wx, wy, wz = ang
-                dx, dy, dz = p[0] - nail[0], p[1] - nail[1], p[2] - nail[2]
-                deviations.append(
-                    (
-                        dx, dy, dz, lin[0] + wy * r[2] - wz * r[1],
-                        lin[1] + wz * r[0] - wx * r[2], lin[2] + wx * r[1] - wy * r[0],
-                    )
-                )  # fmt: skip
-                ptls.append(ptime[i] - time)
-            else:
-                deviations.append(_ZERO6)
-                ptls.append(0.0)
-            if has_ori[i]:
-                phi = unwrap_rotvec(rotvec_from_quat(quat_conj_mul(orn, goal_q[i])), phis[i])
-                phis[i] = phi
-                otls.append(otime[i] - time)
-            else:
-                otls.append(0.0)
+        for i, state in enumerate(states):
+            point, deviation, ptl, phis[i], otl = measure(
+                state, time, offsets[i], has_offset[i], nails[i], has_pos[i], ptime[i],
+                goal_q[i], has_ori[i], otime[i], phis[i],
+            )  # fmt: skip
+            points.append(point)
+            deviations.append(deviation)
+            ptls.append(ptl)
+            otls.append(otl)
         self.points = points
         self.deviations = deviations
         self.position_time_left = ptls

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
+
+from .elementwise import all_, atan2, rint, sqrt, where, where3
 
 __all__ = [
     "conjugate", "exp", "exp_normalized", "log", "mul", "mul_conjugate", "rotate", "to_matrix",
@@ -18,6 +21,7 @@ __all__ = [
 
 Quat = tuple[float, float, float, float]
 Vec3 = tuple[float, float, float]
+TWO_PI = 2.0 * math.pi
 
 
 def mul(a: Sequence[float], b: Sequence[float]) -> Quat:
@@ -73,43 +77,67 @@ def exp_normalized(r: Sequence[float]) -> Quat:
     return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
 
 
-def log(q: Sequence[float]) -> Vec3:
-    """Principal rotation vector (angle in ``[0, pi]``) of a unit quaternion (``Log``)."""
+def log(q: Sequence[Any]) -> tuple[Any, Any, Any]:
+    """Principal rotation vector (angle in ``[0, pi]``) of a unit quaternion (``Log``); also
+    elementwise on arrays of components (:mod:`sgc_env.paper.elementwise`)."""
     x, y, z, w = q
-    if w < 0.0:
-        x, y, z, w = -x, -y, -z, -w
-    vnorm = math.sqrt(x * x + y * y + z * z)
-    if vnorm < 1e-12:
+    flip = w < 0.0
+    if flip is True or flip is not False and flip.any():  # any_ and all_ inline: elementwise
+        if flip is True or flip.all():
+            x, y, z, w = -x, -y, -z, -w
+        else:
+            x, y, z, w = (
+                where(flip, -x, x),
+                where(flip, -y, y),
+                where(flip, -z, z),
+                where(flip, -w, w),
+            )
+    vnorm = sqrt(x * x + y * y + z * z)
+    small = vnorm < 1e-12
+    if small is False or small is not True and not small.any():
+        scale = 2.0 * atan2(vnorm, w) / vnorm
+    elif small is True or small.all():
         scale = 2.0 / w
     else:
-        scale = 2.0 * math.atan2(vnorm, w) / vnorm
+        scale = where(small, 2.0 / w, 2.0 * atan2(vnorm, w) / vnorm)
     return (x * scale, y * scale, z * scale)
 
 
-def unwrap_rotvec(principal: Sequence[float], reference: Sequence[float]) -> Vec3:
+def unwrap_rotvec(principal: Sequence[Any], reference: Sequence[Any]) -> tuple[Any, Any, Any]:
     """The rotation vector of the same rotation that lies closest to ``reference`` (the one
-    unwrap of the project: env deviations, planner, expert and comparison controllers).
+    unwrap of the project: env deviations, the batched env's, planner, expert and comparison
+    controllers; elementwise on arrays of components as well).
 
     Same rotation = axis * (angle + 2 pi k) for any integer k (the family along ``-axis`` is
     the same set), so a tracked deviation phi stays continuous across steps and a
     somersault's |phi| can exceed pi. For the identity the axis is taken from ``reference``.
     """
     px, py, pz = principal
-    angle = math.sqrt(px * px + py * py + pz * pz)
     rx, ry, rz = reference
-    if angle < 1e-12:
-        rn = math.sqrt(rx * rx + ry * ry + rz * rz)
-        if rn < math.pi:
+    angle = sqrt(px * px + py * py + pz * pz)
+    small = angle < 1e-12
+    keep = small
+    if small is True or small is not False and small.any():
+        rn = sqrt(rx * rx + ry * ry + rz * rz)
+        keep = small & (rn < math.pi)
+        if all_(keep):
             return (px, py, pz)
-        ux, uy, uz = rx / rn, ry / rn, rz / rn
+        if all_(small):
+            ux, uy, uz = rx / rn, ry / rn, rz / rn
+        else:
+            ux, uy, uz = where3(
+                small, (rx / rn, ry / rn, rz / rn), (px / angle, py / angle, pz / angle)
+            )
     else:
         ux, uy, uz = px / angle, py / angle, pz / angle
-    s = ux * rx + uy * ry + uz * rz
-    k = round((s - angle) / (2.0 * math.pi))
-    if k == 0:
+    k = rint((ux * rx + uy * ry + uz * rz - angle) / TWO_PI)
+    keep = keep | (k == 0)
+    if keep is True or keep is not False and keep.all():
         return (px, py, pz)
-    a = angle + 2.0 * math.pi * k
-    return (ux * a, uy * a, uz * a)
+    a = angle + TWO_PI * k
+    if keep is False or not keep.any():
+        return (ux * a, uy * a, uz * a)
+    return where3(keep, (px, py, pz), (ux * a, uy * a, uz * a))
 
 
 def rotate(q: Sequence[float], v: Sequence[float]) -> Vec3:

@@ -13,7 +13,7 @@ from stable_baselines3.common.vec_env import VecNormalize
 from baselines import SGCExpert
 from baselines.agents.sb3_vec_env import BatchedVecEnv, make_sgc_vec
 from baselines.common.sub_envs import base_env
-from sgc_env.envs import batch as batch_module
+from sgc_env.envs.vector import batch as batch_module
 
 
 @pytest.fixture(autouse=True)

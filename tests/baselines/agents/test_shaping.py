@@ -30,7 +30,7 @@ def test_offsets_are_the_env_schedule_cost_below_the_cap() -> None:
     above = below = 0
     for n in range(120):
         x = schedule_offsets(obs[None])[0, 0]
-        costs = [schedule_cost(track, floor) for track, floor in tracks_of(env.unwrapped.task)]
+        costs = [schedule_cost(*track[1:]) for track in tracks_of(env.unwrapped.task)]
         np.testing.assert_allclose(np.minimum(x, 1.0), costs, atol=1e-4)
         above, below = above + int(x.max() > 1.0), below + int(x.min() < 1.0)
         obs, _, terminated, truncated, _ = env.step(_push(n))

@@ -12,7 +12,7 @@ import pytest
 from baselines.evaluation.episodes import run_episodes_batched, sub_info
 from baselines.evaluation.harness import evaluate, json_ready
 from baselines.policies import make_policy
-from sgc_env.envs.vector_env import make_vec
+from sgc_env.envs.vector.vector_env import make_vec
 
 
 def _as_json(value):

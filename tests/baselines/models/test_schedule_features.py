@@ -56,10 +56,10 @@ def test_features_are_the_on_schedule_error_and_its_rate() -> None:
         error, rate = _by_hand(env, obs)
         np.testing.assert_allclose(feats[0:3] * 0.05, error, atol=1e-5)
         np.testing.assert_allclose(feats[3:6] * 0.5, rate, atol=1e-5)
-        (track, floor), = tracks_of(env.unwrapped.task)  # the reward's own schedule
-        cost = schedule_cost(track, floor)
+        (_, d, left, course, floor), = tracks_of(env.unwrapped.task)  # the reward's own schedule
+        cost = schedule_cost(d, left, course, floor)
         if cost < TRACK_COST_CAP:
-            scale = max(float(np.linalg.norm(track[2][:3])), floor)
+            scale = max(float(np.linalg.norm(course[:3])), floor)
             assert np.linalg.norm(feats[0:3] * 0.05) == pytest.approx(cost * scale, abs=1e-5)
             against_reward += 1
         assert np.all(feats[TRACK_FEATURES : 2 * TRACK_FEATURES - 2] == 0)  # no orientation track

@@ -12,9 +12,11 @@ import pytest
 import sgc_env
 from baselines import SGCExpert
 from baselines.agents.pushes import Pushes, apply_random_push
-from sgc_env.envs import batch as batch_module
-from sgc_env.envs.rewards import REWARD_MODES
-from sgc_env.envs.vector_env import SGCVectorEnv, make_vec
+from sgc_env.envs.rewards import REWARD_MODES, RewardMode, StepScore, effort
+from sgc_env.envs.vector import batch as batch_module
+from sgc_env.envs.vector import task as task_module
+from sgc_env.envs.vector.vector_env import SGCVectorEnv, make_vec
+from sgc_env.envs.views import ObservationView
 
 # Random three-rod scenes cost ~0.2 s per reset (planned feasibility): fewer, shorter runs.
 SIZES = {"SGCThreeRodsRandom-v2": (2, 40), "SGCThreeRods-v1": (2, 45)}
@@ -76,10 +78,10 @@ def run_pair(
     seed: int = 11,
     **kwargs: Any,
 ) -> int:
-    """Step ``make_vec(env_id, n)`` beside n ``gym.make(env_id)`` envs (reset with seed + i,
-    reset again on their own after an episode, as next-step autoreset does) and assert every
-    output equal. Returns the number of autoresets."""
-    vec = make_vec(env_id, n, **kwargs)
+    """Step ``gym.make_vec(env_id, n)`` (every id's vector entry point) beside n
+    ``gym.make(env_id)`` envs (reset with seed + i, reset again on their own after an episode,
+    as next-step autoreset does) and assert every output equal. Returns the number of autoresets."""
+    vec = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point", **kwargs)
     singles = [gym.make(env_id, **kwargs) for _ in range(n)]
     rng = np.random.default_rng(seed)
     experts = [_Expert() for _ in range(n)]
@@ -112,7 +114,8 @@ def run_pair(
                         twin.bit_generator.state = state
                         vflat = _row(vobs, i)
                         vflat = vflat["observation"] if isinstance(vflat, dict) else vflat
-                        twin_obs = apply_random_push(vec.envs[i], vflat, pushes, twin, tick)
+                        sub_env = vec.unwrapped.envs[i]
+                        twin_obs = apply_random_push(sub_env, vflat, pushes, twin, tick)
                         assert _same(twin_obs, pushed)
                         obs[i] = pushed
                     actions[i] = experts[i](env, obs[i], bool(fresh[i]))
@@ -137,7 +140,7 @@ def run_pair(
     return resets
 
 
-@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)
+@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS + sgc_env.LEARNER_IDS)
 def test_every_id_equals_single_envs_under_random_actions(env_id: str) -> None:
     n, steps = SIZES.get(env_id, (3, 150))
     assert run_pair(env_id, n, steps) >= 2  # random actions leave the workspace: autoresets
@@ -147,6 +150,40 @@ def test_every_id_equals_single_envs_under_random_actions(env_id: str) -> None:
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1", "SGCInterceptRandom-v0"])
 def test_every_reward_mode_equals_single_envs(env_id: str, reward: str) -> None:
     assert run_pair(env_id, 2, 50, reward=reward, max_episode_steps=20) >= 2
+
+
+class _Upright(RewardMode):
+    """A reward of the caller's own: the time left to the first body's position goal, less
+    the effort (plain arithmetic, so it runs on floats and on arrays alike)."""
+
+    def reward(self, step: StepScore) -> Any:
+        _, _, left, _, _ = step.tracks[0]
+        return left - effort(step)
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_a_custom_reward_object_scores_the_same_in_both(env_id: str) -> None:
+    assert run_pair(env_id, 2, 50, reward=_Upright(), max_episode_steps=20) >= 2
+
+
+class _ClockView(ObservationView):
+    """A view of the caller's own: each body's position and the time, from the record."""
+
+    def space(self) -> gym.spaces.Box:
+        return gym.spaces.Box(-1e5, 1e5, (3 * self.layout.n_bodies + 1,), np.float32)
+
+    def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
+        layout = self.layout
+        parts = [record[..., layout.body_slice(j, "position")] for j in range(layout.n_bodies)]
+        parts.append(record[..., layout.global_slice("time")])
+        return np.concatenate(parts, axis=-1).astype(np.float32)
+
+
+@pytest.mark.parametrize("env_id", ["SGCThreeRods-v1", "SGCPointGoal-v0"])
+def test_a_custom_observation_view_observes_the_same_in_both(env_id: str) -> None:
+    assert run_pair(env_id, 2, 50, observation=_ClockView(), max_episode_steps=20) >= 2
+    with pytest.raises(ValueError, match="observation: unknown view 'pixels'.*planner"):
+        gym.make(env_id, observation="pixels")
 
 
 @pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])
@@ -220,3 +257,13 @@ def test_small_batches_step_each_sub_env(env_id: str, monkeypatch: pytest.Monkey
     finally:
         vec.close()
     assert run_pair(env_id, 2, 45, max_episode_steps=20) >= 2
+
+
+@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCThreeRods-v1"])
+def test_goal_switches_measured_on_arrays_equal_single_envs(
+    env_id: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Sub-envs whose goals switch are measured again one by one on floats, or, when many
+    switch at once, by one pass on arrays: forced here, the same bits."""
+    monkeypatch.setattr(task_module, "SCALAR_MEASURE_ROWS", 0)
+    assert run_pair(env_id, 2, 90, "expert", max_episode_steps=40) >= 2

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from baselines import SGCExpert
-from sgc_env.envs import batch as batch_module
-from sgc_env.envs.batch import MAX_ENVS
-from sgc_env.envs.vector_env import SGCVectorEnv
+from sgc_env.envs.vector import batch as batch_module
+from sgc_env.envs.vector.batch import MAX_ENVS
+from sgc_env.envs.vector.vector_env import SGCVectorEnv
 from sgc_env.simulator import connected_clients
 
 
@@ -108,7 +108,8 @@ def test_close_frees_the_client_and_cycles_leak_nothing() -> None:
     base = len(connected_clients())
     vec = gym.make_vec("SGCIntercept-v0", num_envs=4, vectorization_mode="vector_entry_point")
     vec.reset(seed=0)
-    assert len(connected_clients()) == base + 1  # one client for four sub-envs
+    # one client for the bodies of four sub-envs, one (never stepped) for their props
+    assert len(connected_clients()) == base + 2
     vec.close()
     assert len(connected_clients()) == base
     with pytest.raises(RuntimeError, match="closed"):

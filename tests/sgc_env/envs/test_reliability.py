@@ -189,7 +189,7 @@ def test_long_episode_with_a_moving_prop_is_computed_in_chunks():
     env = SGCEnv(s)
     paths = env._props
     far = paths.last - 5
-    assert paths.at(far)[0] == (far / env.sim_frequency * 0.001, 0.0, 0.0)
+    assert paths.at(far)[0] == [far / env.sim_frequency * 0.001, 0.0, 0.0]
     assert len(paths._chunk) <= CHUNK
     env.close()
 

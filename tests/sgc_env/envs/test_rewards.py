@@ -167,9 +167,9 @@ def test_the_distance_reward_pays_for_arriving_early():
 
 
 @pytest.mark.parametrize("mode", ["schedule", "sparse"])
-def test_failing_never_pays(mode):
+def test_failing_never_pays(mode, make_env):
     """Leaving the workspace at once earns less than any full episode can."""
-    env = gym.make("SGCRod-v0", reward=mode)
+    env = make_env("SGCRod-v0", reward=mode)
     env.reset(seed=HELD_OUT)
     base = env.unwrapped
     steps = base.max_steps
@@ -186,8 +186,8 @@ def test_failing_never_pays(mode):
     env.close()
 
 
-def test_expert_earns_the_goal_bonuses_and_almost_no_cost():
-    env = gym.make("SGCRod-v0", reward="sparse")
+def test_expert_earns_the_goal_bonuses_and_almost_no_cost(make_env):
+    env = make_env("SGCRod-v0", reward="sparse")
     total, infos = episode_return(env, make_policy("expert", env), HELD_OUT)
     goals = sum(len(info.get("goal_reached", [])) for info in infos)
     env.close()
@@ -196,10 +196,10 @@ def test_expert_earns_the_goal_bonuses_and_almost_no_cost():
     assert 2 * goals - 0.1 < total < 2 * goals
 
 
-def test_modes_share_the_physics_and_differ_in_reward():
+def test_modes_share_the_physics_and_differ_in_reward(make_env):
     rewards, observations = {}, []
     for mode in REWARD_MODES:
-        env = gym.make("SGCPoint-v0", reward=mode)
+        env = make_env("SGCPoint-v0", reward=mode)
         env.reset(seed=3)
         out = [env.step(np.full(3, 0.1)) for _ in range(20)]
         env.close()
@@ -209,6 +209,6 @@ def test_modes_share_the_physics_and_differ_in_reward():
     assert len(set(rewards.values())) == len(REWARD_MODES)
 
 
-def test_unknown_reward_mode_names_the_choices():
+def test_unknown_reward_mode_names_the_choices(make_env):
     with pytest.raises(ValueError, match=r"reward: unknown mode 'dense'.*schedule.*distance"):
-        gym.make("SGCPoint-v0", reward="dense")
+        make_env("SGCPoint-v0", reward="dense")

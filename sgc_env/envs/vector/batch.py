@@ -1,8 +1,8 @@
 """N sub-envs in shared PyBullet worlds, stepped together: the core of both vector env APIs.
 
 Each sub-env is an ordinary :class:`~sgc_env.envs.sgc_env.SGCEnv` (or goal env) built on a
-:class:`~sgc_env.envs.world.WorldView` of a :class:`~sgc_env.envs.world.SharedWorld`; the
-scenes are spread over worlds of about :data:`SHARD_OBJECTS` objects (why: there). A control
+:class:`~.world.WorldView` of a :class:`~.world.SharedWorld`; the scenes are spread over
+worlds of about :data:`SHARD_OBJECTS` bodies (why: there). A control
 step gathers every stepping sub-env's drives, runs each world's substeps once, then observes
 every sub-env. The Gymnasium (:mod:`.vector_env`) and SB3 (``baselines.agents.sb3_vec_env``)
 adapters differ only in their reset conventions and in how they batch what this returns.
@@ -13,8 +13,8 @@ starts exactly where a single env's reset would.
 
 Plain ``SGCEnv`` sub-envs (every id but the goal-conditioned one; :data:`FAST_MIN_ENVS` or
 more of them) step by the fast path,
-:meth:`Batch.step_fast`: the task work of all sub-envs at once in numpy
-(:class:`~sgc_env.envs.batch_task.BatchTask`), the sub-env objects brought up to date only
+:meth:`Batch.step_fast`: the single env's task rules run on all sub-envs at once
+(:class:`~.task.BatchTask`), the sub-env objects brought up to date only
 when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
 ``_finish_step`` (:meth:`Batch.step`).
 """
@@ -27,10 +27,11 @@ import numpy as np
 
 from sgc_env.episode_steps import check_episode_length
 
-from .actuation import clip_action
-from .batch_task import BatchTask, GoalEvent
-from .sgc_env import SGCEnv
-from .world import SharedWorld
+from ..actuation import clip_action
+from ..sgc_env import SGCEnv
+from ..task import GoalEvent
+from .task import BatchTask
+from .world import PropWorld, SharedWorld
 
 __all__ = ["FAST_MIN_ENVS", "MAX_ENVS", "MAX_WORLDS", "SHARD_OBJECTS", "Batch", "check_num_envs",
            "scenes_per_world"]  # fmt: skip
@@ -44,7 +45,8 @@ StepResult = tuple[Any, float, bool, bool, Any]
 
 
 SHARD_OBJECTS = 8
-"""Objects (bodies and props) per PyBullet world, about. Why shards: PyBullet's
+"""Bodies per PyBullet world, about (props live in a client of their own, never stepped:
+:attr:`~sgc_env.envs.vector.world.SharedWorld.props`). Why shards: PyBullet's
 ``stepSimulation`` costs O(objects^2) in one world even without collision shapes
 (scripts/bench_world_step.py: about 2 us per body-step in worlds of 4 to 8 bodies, 11 at 64,
 95 at 256), so the batch spreads its scenes over several worlds (clients); a world of one
@@ -76,7 +78,7 @@ def check_num_envs(num_envs: object) -> int:
     if not 1 <= num_envs <= MAX_ENVS:
         raise ValueError(
             f"num_envs must be in [1, {MAX_ENVS}], got {num_envs} (the cap: see "
-            "sgc_env.envs.batch.MAX_ENVS)"
+            "sgc_env.envs.vector.batch.MAX_ENVS)"
         )
     return num_envs
 
@@ -97,15 +99,16 @@ class Batch:
         if kwargs.get("render_mode") is not None:
             raise ValueError("render_mode: the batched env does not render; use a single env")
         frequency = int(kwargs.get("sim_frequency", 240))
-        self.worlds = [SharedWorld(frequency)]
         self._envs: list[SGCEnv] = []
         self.closed = False
+        self.props = PropWorld(frequency)  # never stepped
+        self.worlds = [SharedWorld(frequency, self.props)]
         try:
             self._envs.append(env_class(**kwargs, world=self.worlds[0]))
-            per_world = scenes_per_world(n, len(self._envs[0].sim.bodies))
+            per_world = scenes_per_world(n, len(self._envs[0].scenario.bodies))
             for i in range(1, n):
                 if i % per_world == 0:
-                    self.worlds.append(SharedWorld(frequency))
+                    self.worlds.append(SharedWorld(frequency, self.props))
                 self._envs.append(env_class(**kwargs, world=self.worlds[-1]))
         except BaseException:
             self.close()
@@ -201,19 +204,16 @@ class Batch:
         """One control step of the listed sub-envs (their clipped actions) in one world step;
         the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
         envs = self._envs
-        by_world: dict[int, tuple[list[Any], list[list[Any]]]] = {}
+        by_world: dict[int, list[Any]] = {}
         for i, v in zip(indices, values, strict=True):
-            d, m = envs[i]._drives(v)
-            drives, moves = by_world.setdefault(
-                envs[i].sim.client, ([], [[] for _ in range(self.substeps)])
-            )
-            drives += d
-            for k, mk in enumerate(m):
-                moves[k] += mk
+            d, moves = envs[i]._drives(v)
+            by_world.setdefault(envs[i].sim.client, []).extend(d)
+            if moves:  # props: where the step leaves them (see BatchTask._place_props)
+                for uid, spot in moves[-1]:
+                    envs[i].sim.move(uid, spot)
         for world in self.worlds:
             if world.client in by_world:
-                drives, moves = by_world[world.client]
-                world.sim.step_bodies(drives, moves if any(moves) else ())
+                world.sim.step_bodies(by_world[world.client])
         results = []
         limit, elapsed = self.limit, self.elapsed
         for i, v in zip(indices, values, strict=True):
@@ -230,4 +230,5 @@ class Batch:
             env.close()
         for world in self.worlds:
             world.close()
+        self.props.close()
         self.closed = True

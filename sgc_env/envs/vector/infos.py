@@ -1,10 +1,11 @@
 """The infos of a batched step, read straight from the step's shared buffers.
 
-The single env's info (:mod:`.step_info`) hands out views of its step record; the batched
-task (:mod:`.batch_task`) keeps one (N, record) buffer per step, so the vector info dict's
+The single env's info (:mod:`..step_info`) hands out views of its step record; the batched
+task (:mod:`.task`) keeps one (N, record) buffer per step, so the vector info dict's
 arrays are views of its columns (Gymnasium's layout: per key an array over sub-envs and a
 ``_key`` mask) and SB3's per-sub-env dicts are rows of those views: no per-sub-env info is
-built first. The values equal what ``batch_infos`` makes of the single envs' infos.
+built first. Both read the record through :func:`~sgc_env.envs.step_info.info_arrays`, so the
+values equal what ``batch_infos`` makes of the single envs' infos.
 """
 
 from __future__ import annotations
@@ -13,69 +14,31 @@ from typing import Any
 
 import numpy as np
 
-from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
+from sgc_env.observation import BODY_BLOCK_SIZE
 
-from .batch_task import BatchTask
-from .task import GoalEvent
+from ..step_info import INFO_ARRAYS, info_arrays
+from ..task import GoalEvent
+from .task import BatchTask
 
 __all__ = ["row_infos", "vector_infos"]
 
-_L = ObservationLayout(1)
-
-
-def _block_index(name: str) -> slice | int:
-    """The body-block columns of a field (one column as an int: a (N, bodies) array)."""
-    cols = _L.body_slice(0, name)
-    return cols if cols.stop - cols.start > 1 else cols.start
-
-
-_BLOCK_KEYS = tuple(
-    (key, _block_index(name))
-    for key, name in (
-        ("position_deviation", "position_deviation"),
-        ("orientation_deviation", "orientation_deviation"),
-        ("time_to_goal", "position_time_left"),
-        ("orientation_time_to_goal", "orientation_time_left"),
-        ("body_position", "position"),
-        ("body_orientation", "orientation"),
-        ("body_velocity", "linear_velocity"),
-        ("body_angular_velocity", "angular_velocity"),
-        ("point_velocity", "point_velocity"),
-    )
-)
-_ORDER = (
-    "goal_index", "orientation_goal_index", "position_deviation", "orientation_deviation",
-    "time_to_goal", "orientation_time_to_goal", "body_position", "body_orientation",
-    "body_velocity", "body_angular_velocity", "point_position", "point_velocity", "force",
-    "torque",
-)  # fmt: skip
-"""``step_info``'s array keys in its order (``time`` comes first, ``spin_clamped`` last)."""
-
-
-def _columns(task: BatchTask) -> dict[str, np.ndarray]:
-    """Every per-body info array over sub-envs: (N, bodies[, 3]) views of the record."""
+def _columns(task: BatchTask) -> dict[str, Any]:
+    """Every every-step info entry over sub-envs: (N, bodies[, 3]) views of the record."""
     n, b, size = task.n, task.b, task.size
     rec = task.rec
     block = rec[:, : size - 1].reshape(n, b, BODY_BLOCK_SIZE)
-    tail = rec[:, size:].reshape(n, 3, b, 3)
-    out = {
-        "goal_index": task.goal_index.copy(),
-        "orientation_goal_index": task.orientation_goal_index.copy(),
-        "point_position": tail[:, 0],
-        "force": tail[:, 1],
-        "torque": tail[:, 2],
-    }
-    for key, cols in _BLOCK_KEYS:
-        out[key] = block[..., cols]
-    return {key: out[key] for key in _ORDER}
+    tail = rec[:, size:].reshape(n, 3, b, 3).transpose(1, 0, 2, 3)
+    return info_arrays(
+        rec[:, size - 1], block, tail, task.goal_index.copy(),
+        task.orientation_goal_index.copy(), task.spin.copy(),
+    )  # fmt: skip
 
 
 def vector_infos(task: BatchTask, events: dict[int, list[GoalEvent]]) -> dict[str, Any]:
     """Gymnasium's vector info of a step where every sub-env reported (stepped or reset)."""
     n = task.n
-    values: dict[str, Any] = {"time": task.rec[:, task.size - 1].copy()}
-    values.update(_columns(task))
-    values["spin_clamped"] = task.spin.copy()
+    values = _columns(task)
+    values["time"] = values["time"].copy()
     out: dict[str, Any] = {}
     for key, value in values.items():
         out[key] = value
@@ -98,8 +61,6 @@ def row_infos(
     when the dict is first read (:class:`RowInfo`); ``key`` holds ``values[i]`` in dict i
     (the caller's own entry, e.g. SB3's ``TimeLimit.truncated``)."""
     columns = _columns(task)
-    columns["time"] = task.rec[:, task.size - 1]
-    columns["spin_clamped"] = task.spin.copy()
     infos: list[dict[str, Any]] = [
         RowInfo(columns, i, key, value) for i, value in enumerate(values)
     ]
@@ -108,7 +69,7 @@ def row_infos(
     return infos
 
 
-_LAZY = frozenset(("time", *_ORDER, "spin_clamped"))
+_LAZY = frozenset(("time", *INFO_ARRAYS, "spin_clamped"))
 
 
 def _filling(name: str) -> Any:
@@ -145,7 +106,7 @@ class RowInfo(dict[str, Any]):
         added = dict.copy(self)
         dict.clear(self)
         dict.__setitem__(self, "time", float(columns["time"][i]))
-        for key in _ORDER:
+        for key in INFO_ARRAYS:
             dict.__setitem__(self, key, columns[key][i])
         dict.__setitem__(self, "spin_clamped", bool(columns["spin_clamped"][i]))
         dict.update(self, added)

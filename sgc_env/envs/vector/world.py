@@ -26,14 +26,42 @@ from typing import Any
 from sgc_env.scenario import Scenario
 from sgc_env.simulator import BodyHandle, Simulator, pybullet
 
-__all__ = ["SharedWorld", "WorldView"]
+__all__ = ["PropWorld", "SharedWorld", "WorldView"]
+
+
+class PropWorld:
+    """The client where the sub-envs' kinematic props live, made when the first prop arrives
+    and never stepped. Why: props collide with nothing in a shared world (no object has a
+    collision shape), so only their positions matter, and static objects in a stepped world
+    cost as much per substep as bodies (three-rod worlds of 9 rods and 12 props stepped in
+    15 us, 5.5 us without the props: scripts/bench_world_step.py's method)."""
+
+    def __init__(self, sim_frequency: int) -> None:
+        self._frequency = sim_frequency
+        self._sim: Simulator | None = None
+
+    @property
+    def sim(self) -> Simulator:
+        if self._sim is None:
+            self._sim = Simulator(sim_frequency=self._frequency)
+        return self._sim
+
+    @property
+    def open(self) -> bool:
+        return self._sim is not None and self._sim.client >= 0
+
+    def close(self) -> None:
+        if self._sim is not None:
+            self._sim.close()
 
 
 class SharedWorld:
     """The shared client and what every sub-env must agree on (see the module docstring)."""
 
-    def __init__(self, sim_frequency: int) -> None:
+    def __init__(self, sim_frequency: int, props: PropWorld | None = None) -> None:
         self.sim = Simulator(sim_frequency=sim_frequency)
+        self._own_props = props is None
+        self.props = PropWorld(sim_frequency) if props is None else props
         self.gravity: tuple[float, ...] | None = None
 
     @property
@@ -60,7 +88,7 @@ class SharedWorld:
             raise ValueError(
                 f"scenario {s.name!r}: objects {colliding} collide with each other; contacts "
                 "inside one sub-env of a shared world are not bit-identical to a single env's "
-                "(see sgc_env/envs/world.py), so the batched env takes scenes with at most "
+                "(see sgc_env/envs/vector/world.py), so the batched env takes scenes with at most "
                 "one colliding object: set collisions: false or use single envs"
             )
         g = tuple(float(x) for x in s.gravity)
@@ -75,6 +103,8 @@ class SharedWorld:
 
     def close(self) -> None:
         self.sim.close()
+        if self._own_props:
+            self.props.close()
 
 
 class WorldView(Simulator):
@@ -87,10 +117,49 @@ class WorldView(Simulator):
         self.client = world.client
         self.bodies: dict[str, BodyHandle] = {}
         self.markers: list[int] = []
+        self._props: dict[str, int] = {}
         self._get_pose = world.sim._get_pose
         self._get_velocity = world.sim._get_velocity
 
     def add_body(self, name: str, *args: Any, **kwargs: Any) -> BodyHandle:
+        if kwargs.get("kinematic"):
+            return self._add_prop(name, *args, **kwargs)
+        return self._add_dynamic(name, *args, **kwargs)
+
+    def _add_prop(
+        self, name: str, shape: str, size: Sequence[float], mass: float, *args: Any, **kwargs: Any
+    ) -> BodyHandle:
+        """A kinematic prop in the world's prop client (:attr:`SharedWorld.props`): a bare
+        body, no collision or visual shape (moving one of hundreds of overlapping collision
+        shapes updated the broadphase's pairs: 256 props took ~50 us each to place)."""
+        if name in self.bodies:
+            raise ValueError(f"a body named {name!r} already exists")
+        sim = self.world.props.sim
+        uid = pybullet.createMultiBody(baseMass=0.0, physicsClientId=sim.client)
+        self.bodies[name] = handle = BodyHandle(name, uid, shape, tuple(size), float(mass))
+        self._props[name] = uid
+        return handle
+
+    def remove_body(self, name: str) -> None:
+        if name in self._props:
+            uid = self._props.pop(name)
+            self.bodies.pop(name)
+            if self.world.props.open:
+                pybullet.removeBody(uid, physicsClientId=self.world.props.sim.client)
+            return
+        super().remove_body(name)
+
+    def move(
+        self, uid: int, position: Sequence[float], orientation: Sequence[float] = (0, 0, 0, 1)
+    ) -> None:
+        """Place a prop (props live in the prop client)."""
+        self.world.props.sim.move(uid, position, orientation)
+
+    @property
+    def prop_client(self) -> int:
+        return self.world.props.sim.client
+
+    def _add_dynamic(self, name: str, *args: Any, **kwargs: Any) -> BodyHandle:
         """A body without a collision shape, so the broadphase never sees it (N scenes at the
         same coordinates would make every pair of their objects overlap, O(N^2) per substep),
         with the mass and inertia PyBullet computes for the shape (read off a probe body made

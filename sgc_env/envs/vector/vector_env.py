@@ -28,10 +28,10 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array
 
+from ..goal_env import SGCGoalEnv
+from ..sgc_env import SGCEnv
 from .batch import Batch
-from .batch_infos import vector_infos
-from .goal_env import SGCGoalEnv
-from .sgc_env import SGCEnv
+from .infos import vector_infos
 
 __all__ = ["SGCGoalVectorEnv", "SGCVectorEnv", "batch_infos", "make_vec"]
 
@@ -155,7 +155,7 @@ class SGCVectorEnv(VectorEnv):
             self._obs[i] = obs
             rewards[i], terminated[i], truncated[i] = reward, term, trunc
             infos.append(info)
-        for i in resetting:  # after the physics: see sgc_env.envs.batch
+        for i in resetting:  # after the physics: see sgc_env.envs.vector.batch
             self._obs[i], info = self._batch.reset_one(i)
             infos.append(info)
         self._autoreset = terminated | truncated
@@ -170,7 +170,7 @@ class SGCVectorEnv(VectorEnv):
         """:meth:`step` of plain SGC sub-envs: arrays from the batch's shared buffers."""
         batch = self._batch
         rewards, terminated, truncated, events = batch.step_fast(stepping, actions)
-        for i in resetting:  # after the physics: see sgc_env.envs.batch
+        for i in resetting:  # after the physics: see sgc_env.envs.vector.batch
             self._obs[i] = batch.reset_one(i)[0]
         if resetting:
             rewards[resetting] = 0.0
