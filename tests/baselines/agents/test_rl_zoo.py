@@ -36,3 +36,53 @@ def test_rl_zoo3_trains_ppo_on_sgc_point(tmp_path: Path) -> None:
     action, _ = model.predict(obs, deterministic=True)
     assert env.action_space.contains(action)
     env.close()
+
+
+ZOO = Path(__file__).resolve().parents[3] / "benchmarks" / "zoo"
+
+
+@pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "her"])
+def test_zoo_files_name_stock_classes_and_the_newest_ids(algo: str) -> None:
+    """``benchmarks/zoo/*.yml``: keyed by the newest ids, SB3's own policies, no project class
+    or wrapper (what a researcher runs with the field's tools)."""
+    import sgc_env
+    from rl_zoo3.utils import get_wrapper_class
+
+    text = (ZOO / f"{algo}.yml").read_text()
+    import yaml
+
+    table = yaml.safe_load(text)
+    assert table and set(table) <= set(sgc_env.LEARNER_IDS)
+    for env_id, hp in table.items():
+        assert hp["policy"] in ("MlpPolicy", "MultiInputPolicy"), env_id
+        assert get_wrapper_class(hp) is None and "env_wrapper" not in hp
+        assert "baselines" not in str(hp) and "Features" not in str(hp)
+
+
+def test_rl_zoo3_model_on_the_newest_rod_scores_through_the_harness(tmp_path: Path) -> None:
+    """rl-zoo3 trains PPO on ``SGCRod-v1`` from ``benchmarks/zoo/ppo.yml`` (a few steps); its
+    pickled statistics are refused until converted, then the harness scores the model."""
+    command = [
+        sys.executable, "-m", "rl_zoo3.train", "--algo", "ppo", "--env", "SGCRod-v1",
+        "--gym-packages", "sgc_env", "--conf-file", str(ZOO / "ppo.yml"),
+        "-n", "256", "--hyperparams", "n_envs:2", "n_steps:64", "batch_size:64",
+        "--eval-freq", "-1", "--save-freq", "-1", "--seed", "0", "--device", "cpu",
+        "-f", str(tmp_path / "logs"),
+    ]  # fmt: skip
+    done = subprocess.run(command, capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
+    (model_file,) = (tmp_path / "logs" / "ppo").glob("SGCRod-v1_*/SGCRod-v1.zip")
+    stats = model_file.parent / "SGCRod-v1" / "vecnormalize.pkl"
+    assert stats.is_file()
+    from baselines.evaluation.harness import evaluate
+
+    with pytest.raises(ValueError, match="pickle.*convert"):
+        evaluate(str(model_file), "SGCRod-v1", episodes=1, seed=20000)
+    converted = subprocess.run(
+        [sys.executable, "scripts/convert_models.py", str(stats)],
+        capture_output=True, text=True, timeout=120, cwd=Path(__file__).resolve().parents[3],
+    )  # fmt: skip
+    assert converted.returncode == 0, converted.stderr[-2000:]
+    assert stats.with_suffix(".json").is_file() and not stats.exists()
+    result = evaluate(str(model_file), "SGCRod-v1", episodes=1, seed=20000)
+    assert result.summary["episodes"] == 1
