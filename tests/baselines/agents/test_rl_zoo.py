@@ -45,8 +45,9 @@ ZOO = Path(__file__).resolve().parents[3] / "benchmarks" / "zoo"
 def test_zoo_files_name_stock_classes_and_the_newest_ids(algo: str) -> None:
     """``benchmarks/zoo/*.yml``: keyed by the newest ids, SB3's own policies, no project class
     or wrapper (what a researcher runs with the field's tools)."""
-    import sgc_env
     from rl_zoo3.utils import get_wrapper_class
+
+    import sgc_env
 
     text = (ZOO / f"{algo}.yml").read_text()
     import yaml
