@@ -207,13 +207,14 @@ def _move_files(stage: Path, out: Path, folder: str = "") -> None:
 
 @contextlib.contextmanager
 def staged_output(out: Path, keep_on_failure: tuple[str, ...] = ()) -> Iterator[Path]:
-    """A temporary folder next to ``out`` to write into; on success its files replace those
-    of the same name under ``out`` (others there are kept), on any failure or interrupt it is
-    removed and ``out`` is left as it was, except for the subfolders ``keep_on_failure``
-    (e.g. a training run's checkpoints, new files that replace nothing whole)."""
+    """A fresh temporary folder inside ``out`` to write into (nothing is written outside
+    ``out``); on success its files replace those of the same name under ``out`` (others there
+    are kept), on any failure or interrupt it is removed and ``out`` keeps its files, except
+    for the subfolders ``keep_on_failure`` (e.g. a training run's checkpoints, new files that
+    replace nothing whole)."""
     out = Path(out)
-    out.absolute().parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.absolute().parent))
+    out.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".partial-", dir=out))
     try:
         yield stage
         _move_files(stage, out)

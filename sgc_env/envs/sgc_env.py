@@ -123,6 +123,7 @@ from sgc_env.render.camera import View
 from sgc_env.render.modes import available_render_modes
 from sgc_env.render.scene import CameraSpec, SceneRenderer, check_size
 from sgc_env.scenario import Scenario, resolve_scenario
+from sgc_env.scenario.caps import cap
 from sgc_env.scenes import PRESETS, SceneFamily
 from sgc_env.scenes import random_scenario as draw_random_scenario
 from sgc_env.simulator import Drive, Simulator
@@ -203,6 +204,11 @@ class SGCEnv(gym.Env):
             raise ValueError(
                 f"sim_frequency {sim_frequency} Hz must be a positive integer multiple of the "
                 f"control frequency {cf} Hz"
+            )
+        if self.sim_frequency > cap("sim_frequency"):
+            raise ValueError(
+                f"sim_frequency {sim_frequency} Hz is over the cap of {cap('sim_frequency')} Hz "
+                "(every control tick runs sim_frequency / control_frequency PyBullet steps)"
             )
         self.control_frequency = cf
         self.substeps = self.sim_frequency // cf

@@ -508,3 +508,15 @@ def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
     assert left_open.unwrapped.sim is None and left_open.unwrapped._closed
     assert not sgc_env.simulator.pybullet.isConnected(physicsClientId=client)
     assert set(close_envs) >= set(made)  # nested blocks: the autouse fixture saw them too
+
+
+def test_sim_frequency_over_the_cap_is_refused_by_the_env_itself() -> None:
+    """Code that calls gym.make directly meets the same cap as --env-kwargs and recipes."""
+    from sgc_env.scenario.caps import cap
+
+    limit = cap("sim_frequency")
+    with pytest.raises(ValueError, match="over the cap"):
+        gym.make("SGCPoint-v0", sim_frequency=limit - limit % 60 + 60)
+    env = gym.make("SGCPoint-v0", sim_frequency=limit - limit % 60)
+    assert env.unwrapped.substeps == (limit - limit % 60) // 60
+    env.close()
