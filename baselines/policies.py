@@ -27,6 +27,7 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
+from baselines.common.observation_fields import require_planner_view
 from baselines.common.shipped import resolve_policy_spec
 from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
@@ -217,14 +218,7 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
             f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
             f"{type(env.observation_space).__name__}"
         )
-    first = getattr(env, "envs", [env])[0] if isinstance(env, gym.vector.VectorEnv) else env
-    view = getattr(getattr(first, "unwrapped", first), "observation_view", "planner")
-    if view != "planner":
-        raise ValueError(
-            f"policy {spec!r} reads the planner's view; this env observes the {view!r} view: "
-            "make it with observation='planner' (gym.make(id, observation='planner'), as the "
-            "harness does for this policy)"
-        )
+    require_planner_view(env, f"policy {spec!r}")
 
 
 def needs_planner_view(spec: str) -> bool:

@@ -21,7 +21,12 @@ from typing import Any
 import numpy as np
 
 from baselines.common.env_model import BodyModel, EnvModel
-from baselines.common.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.common.observation_fields import (
+    COURSE_SIZE,
+    BodyFields,
+    TrackFields,
+    require_planner_view,
+)
 from baselines.common.sub_envs import base_env
 from baselines.controllers.actuation import body_wrench
 from baselines.controllers.matched_table import (
@@ -89,12 +94,7 @@ class SGCExpert:
         if model is None:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
-            view = getattr(getattr(env, "unwrapped", env), "observation_view", "planner")
-            if view != "planner":
-                raise ValueError(
-                    f"SGCExpert reads the planner's view; this env observes the {view!r} view: "
-                    "make it with gym.make(id, observation='planner')"
-                )
+            require_planner_view(env, "SGCExpert")
             model = EnvModel.from_env(env)
         if end_rule is not None and end_rule not in EXPERT_RULES:
             raise ValueError(f"end_rule must be one of {list(EXPERT_RULES)}, got {end_rule!r}")

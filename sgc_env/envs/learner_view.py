@@ -93,11 +93,10 @@ def learner_size(n_bodies: int) -> int:
 def learner_bounds(n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
     """The view's tight bounds (float32): the squash bound, the clip ranges, [0, 1] and the
     hover action's range (an action is clipped to [-1, 1])."""
-    hover_limit = 1.0
     track_low = [-SQUASH] * 18 + [0.0] + [TIME_LOW] * 2 + [0.0, 0.0]
     track_high = [SQUASH] * 18 + [1.0] + [TIME_HIGH] * 2 + [1.0, 1.0]
-    body_low = track_low * 2 + [-hover_limit] * 3
-    body_high = track_high * 2 + [hover_limit] * 3
+    body_low = track_low * 2 + [-1.0] * 3
+    body_high = track_high * 2 + [1.0] * 3
     low = np.array(body_low * n_bodies + [0.0], dtype=np.float32)
     high = np.array(body_high * n_bodies + [1.0], dtype=np.float32)
     return low, high
