@@ -1,5 +1,6 @@
 """The learner's view: bounded, float32, and the same on-schedule features the policy-side
-extractor computes (an independent implementation in torch, :mod:`baselines.agents.schedule_features`)."""
+extractor computes (an independent implementation in torch,
+:mod:`baselines.models.schedule_features`)."""
 
 from __future__ import annotations
 
@@ -50,7 +51,7 @@ def test_on_schedule_entries_match_the_policy_side_extractor() -> None:
     """Error, rate and schedule velocities of the position track equal ScheduleFeatures' (the
     torch extractor reads the float32 planner observation, so they agree to float32)."""
     th = pytest.importorskip("torch")
-    from baselines.agents.schedule_features import ScheduleFeatures
+    from baselines.models.schedule_features import ScheduleFeatures
 
     env = gym.make("SGCRod-v0")
     obs, _ = env.reset(seed=3)
