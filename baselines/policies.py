@@ -12,7 +12,9 @@ then). Model files are loaded without unpickling anything (:mod:`baselines.model
 unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model trained
 behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
 (:func:`vecnormalize_path`, :mod:`baselines.models.normalization`), so it sees the observations it
-was trained on. Every policy has the SB3 signature
+was trained on. The expert and the comparison controllers read the planner's view; on an env
+that observes another (the newest ids' learner's view) they act on the env's planner view of
+its current state (:mod:`baselines.common.planner_view`). Every policy has the SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
 
@@ -27,7 +29,7 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
-from baselines.common.observation_fields import require_planner_view
+from baselines.common.planner_view import OnPlannerView, observed_view
 from baselines.common.shipped import resolve_policy_spec
 from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
@@ -218,13 +220,14 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
             f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
             f"{type(env.observation_space).__name__}"
         )
-    require_planner_view(env, f"policy {spec!r}")
 
 
 def needs_planner_view(spec: str) -> bool:
     """Whether the policy ``spec`` names reads the planner's view (the expert and the
-    comparison controllers): the harness then makes its env with ``observation="planner"``,
-    the same scenes and dynamics on any version of an id."""
+    comparison controllers). On an env of another view :func:`make_policy` has it read the
+    env's own planner view of its current state
+    (:class:`~baselines.common.planner_view.OnPlannerView`); the harness makes its env with
+    ``observation="planner"`` instead, the same scenes and dynamics on any version of an id."""
     builtin = POLICY_FACTORIES.get(resolve_policy_spec(spec)) if isinstance(spec, str) else None
     return builtin is not None and builtin.flat
 
@@ -294,9 +297,11 @@ def make_policy(
     spec = resolve_policy_spec(spec)
     builtin = POLICY_FACTORIES.get(spec)
     if builtin is not None:
-        if builtin.flat:
-            _needs_flat_observation(env, spec)
-        return builtin.make(env, seed)
+        if not builtin.flat:
+            return builtin.make(env, seed)
+        _needs_flat_observation(env, spec)
+        policy = builtin.make(env, seed)
+        return policy if observed_view(env) == "planner" else OnPlannerView(policy, env)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
         trust = _TRUST_MODELS.get() if trust_model is None else trust_model
         single = _spaces_env(env)

@@ -174,7 +174,9 @@ def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
 
         env = SmoothScheduleCost(env, alive=hp.reward_shaping == "smooth_alive")
     if hp.normalize:
-        env = VecNormalize(env, gamma=hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs)
+        # rl-zoo3's rule: the reward is normalised with the algorithm's gamma unless given
+        env = VecNormalize(env, **{"gamma": hp.algo_kwargs.get("gamma", 0.99),
+                                   **hp.normalize_kwargs})  # fmt: skip
     kwargs = dict(hp.algo_kwargs)
     if cfg.init == "bc":
         from baselines.models.features import StandardizeObservation

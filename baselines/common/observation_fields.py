@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from baselines.common.planner_view import observed_view
 from sgc_env.observation import ObservationLayout
 
 __all__ = [
@@ -26,13 +27,12 @@ __all__ = [
 def require_planner_view(env: Any, reader: str) -> None:
     """A ValueError unless ``env`` (or a vector env's first reachable sub-env) observes the
     planner's view, the one this module decodes; ``reader`` names who needs it."""
-    first = getattr(env, "envs", [env])[0]
-    view = getattr(getattr(first, "unwrapped", first), "observation_view", "planner")
+    view = observed_view(env)
     if view != "planner":
         raise ValueError(
             f"{reader} reads the planner's view; this env observes the {view!r} view: make it "
-            "with gym.make(id, observation='planner') (the harness does so for built-in "
-            "policies)"
+            "with gym.make(id, observation='planner'), or make the policy with "
+            "baselines.policies.make_policy, which reads the env's planner_observation()"
         )
 
 

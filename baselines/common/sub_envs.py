@@ -13,7 +13,7 @@ from typing import Any
 
 import gymnasium as gym
 
-__all__ = ["MODEL_ATTRIBUTES", "base_env", "sub_env"]
+__all__ = ["MODEL_ATTRIBUTES", "base_env", "is_vector", "sub_env"]
 
 MODEL_ATTRIBUTES = (
     "scenario",
@@ -27,7 +27,8 @@ MODEL_ATTRIBUTES = (
 """What a model-based policy reads from the base env (fetched across processes by name)."""
 
 
-def _is_vector(env: Any) -> bool:
+def is_vector(env: Any) -> bool:
+    """Whether ``env`` is a vector env (Gymnasium's or SB3's)."""
     if isinstance(env, gym.vector.VectorEnv):
         return True
     # An SB3 VecEnv exists only once SB3 is imported; not importing it here keeps torch out.
@@ -48,7 +49,7 @@ def sub_env(env: Any, index: int = 0) -> Any:
     Sub-envs behind processes are represented by a stand-in whose ``unwrapped`` carries the
     :data:`MODEL_ATTRIBUTES`, read now (a random-scenario env redraws its scenario per reset).
     """
-    if not _is_vector(env):
+    if not is_vector(env):
         return env
     envs = getattr(env, "envs", None)
     if envs is not None:

@@ -98,10 +98,10 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the look of :mod:`sgc_env.render`),
 ``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
 :class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
-``reward`` (``"schedule"``, ``"distance"`` or
-``"sparse"``, above, or any :class:`~sgc_env.envs.rewards.RewardMode` instance),
-``observation`` (``"planner"``, the layout above, or any
-:class:`~sgc_env.envs.views.ObservationView` instance). ``reset(options={"scenario": ...})``
+``reward`` (a mode above, ``"tracking"`` or a :class:`~sgc_env.envs.rewards.RewardMode`),
+``observation`` (``"planner"``, the layout above, ``"learner"`` or an
+:class:`~sgc_env.envs.views.ObservationView`; ``planner_observation()`` gives the planner's
+view under any). ``reset(options={"scenario": ...})``
 swaps the scenario (same number of bodies and action size; a random-scenario env draws again
 on the next plain reset).
 """
@@ -137,7 +137,7 @@ from .snapshots import SavedState
 from .step_info import StepInfo, step_info
 from .task import GoalEvent, TaskCounters
 from .vector.world import SharedWorld
-from .views import OBS_BOUND, ObservationView, make_view
+from .views import OBS_BOUND, ObservationView, PlannerView, make_view
 
 __all__ = ["MAX_SPEED", "OBS_BOUND", "SPIN_CLAMP", "SGCEnv", "SavedState", "StepInfo"]
 
@@ -233,6 +233,7 @@ class SGCEnv(gym.Env):
         # point positions, forces and torques: sgc_env.envs.record), packed once per step.
         self._record = struct.Struct(f"{self.layout.size + 9 * self._n}d")
         self._view = self._view.bind(self.layout)
+        self._planner_view = PlannerView().bind(self.layout)
         self.observation_space = self._view.space()
         self._renderer: SceneRenderer | None = None
         self._closed = False
@@ -332,6 +333,10 @@ class SGCEnv(gym.Env):
         """The name of the view this env observes (``"planner"``, ``"learner"``, or a custom
         view's ``name``)."""
         return self._view.name
+
+    def planner_observation(self) -> np.ndarray:
+        """The planner's view of the current state under any ``observation`` (the expert's)."""
+        return self._planner_view.observe(np.append(self._block, self._tick * self.dt))
 
     # ---------------------------------------------------------------- reset / step
 

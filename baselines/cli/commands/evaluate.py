@@ -26,6 +26,7 @@ from baselines.cli.checks import (
     trust_model,
 )
 from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
+from sgc_env.envs.rewards import REWARD_MODES
 
 __all__ = ["add_arguments", "run"]
 
@@ -75,7 +76,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_trust_argument(parser)
     parser.add_argument(
         "--reward", default=None, metavar="MODE",
-        help="the env's reward mode (gym.make(id, reward=MODE): schedule, distance, sparse); "
+        help=f"the env's reward mode (gym.make(id, reward=MODE): {', '.join(REWARD_MODES)}); "
         "default: the env's own",
     )  # fmt: skip
 
