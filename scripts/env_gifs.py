@@ -20,7 +20,7 @@ DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    own = [card.env_id for card in CARDS if card.gif_of is None]
+    own = [card.gif_id for card in CARDS if card.gif_of is None]
     parser.add_argument("--ids", nargs="*", default=own)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--fps", type=float, default=8.0)

@@ -9,13 +9,17 @@ writes.
 
 **Versions.** Any change to observations, rewards or dynamics bumps the id's version, as
 Gymnasium does: add a :class:`Version` at the end of the card's ``versions`` (one line) and
-register the id under its new name; ``tests/sgc_env/test_env_cards.py`` checks that every registered
-id carries its card's latest version.
+register the id under its new name. Every registered version of a name gets a page of its own
+(its spaces, rewards and arguments read from that version) with the card's whole version
+history; ``tests/sgc_env/test_env_cards.py`` checks that every registered id is a version on
+its card and that each card's latest version is registered. The learner's view table is read
+from :mod:`sgc_env.envs.learner_view`'s docstring, its one home.
 """
 
 from __future__ import annotations
 
 import argparse
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,6 +27,8 @@ from typing import Any
 
 import gymnasium as gym
 
+from sgc_env.envs import learner_view
+from sgc_env.envs.learner_view import LEARNER_BODY_SIZE, LEARNER_TRACK_SIZE
 from sgc_env.observation import BASE_FIELDS, BODY_FIELDS, RESIDUAL_FIELDS, ObservationLayout
 
 __all__ = ["CARDS", "EnvCard", "Version", "card_markdown", "gif_path", "pages", "write"]
@@ -53,8 +59,20 @@ class EnvCard:
 
     @property
     def env_id(self) -> str:
-        """The registered id: the name and the latest version."""
+        """The newest id: the name and the latest version."""
         return f"{self.name}-{self.versions[-1].version}"
+
+    @property
+    def registered_ids(self) -> list[str]:
+        """The ids of the versions Gymnasium has registered, oldest first (one page each)."""
+        ids = [f"{self.name}-{v.version}" for v in self.versions]
+        return [env_id for env_id in ids if env_id in gym.registry]
+
+    @property
+    def gif_id(self) -> str:
+        """The id whose expert GIF the card shows: ``gif_of``, else the oldest registered
+        version (every version of a name has the same scenes and physics)."""
+        return self.gif_of or self.registered_ids[0]
 
 
 _FIRST = "first release (sgc 0.1.0)."
@@ -69,6 +87,27 @@ _COURSE_BOUND = (
     "milliseconds, not 170 ms (sgc 0.3.0); a looser check, so some v1 scenes are now redrawn "
     "and the same seed gives another scene."
 )
+
+
+def _learner_version(old: str, goal: bool = False) -> str:
+    """The version entry of a name's learner's version; ``old`` the version before it."""
+    reward = ("the reward stays the sparse goal reward" if goal else "`tracking` is the "
+              "default reward (see Rewards: the same on-schedule error as `schedule`, paid in a "
+              "form a learner can climb)")  # fmt: skip
+    kwargs = 'observation="planner"' + ("" if goal else ', reward="schedule"')
+    same = f"`gym.make(id, {kwargs})` steps as `{old}`"
+    return (
+        "the learner's view is the default observation (`observation=\"learner\"`, see "
+        f"Observation Space: bounded entries of order 1 that say what the reward measures) and "
+        f"{reward}. Scenes, dynamics, actions and episode lengths are unchanged: {same}, bit "
+        f"for bit. `{old}` keeps the planner's view and its reward: the benchmark's "
+        "leaderboards, the shipped models and the scorecard use it. The exact expert reads the "
+        "planner's view; on this version it reads `env.unwrapped.planner_observation()`, the "
+        "planner's view of the same state (`make_policy(\"expert\", env)` does so), so "
+        "demonstrations, BC and DAgger store and train on the learner's view."
+    )
+
+
 _RANDOM_START = (
     "A new scene is drawn from the env's `np_random` on every reset (`reset(seed=...)`: same "
     "seed, same scene, bit for bit): "
@@ -83,7 +122,7 @@ CARDS: tuple[EnvCard, ...] = (
         "The bird at rest at (0, 0, 2) m; the fish at (2, -0.5, 0.5) m, swimming through "
         "(1.5, 0, 0.6) m at 1 s and on towards (1, 1, 0.5) m. No noise: every reset is the "
         "same state.",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCIntercept-v0"))),
     ),
     EnvCard(
         "SGCInterceptRandom",
@@ -91,7 +130,7 @@ CARDS: tuple[EnvCard, ...] = (
         "start drawn per reset.",
         _RANDOM_START + "the bird within 0.5 m of (0, 0, 2) at up to 1.5 m/s, the fish within "
         "0.6 m of (2, -0.5, 0.5) swimming two straight legs at 0.3-1.5 m/s.",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCInterceptRandom-v0"))),
     ),
     EnvCard(
         "SGCPoint",
@@ -99,7 +138,7 @@ CARDS: tuple[EnvCard, ...] = (
         "its goal time, and move smoothly through them (Liu, Ko & Chang 1993, point goals).",
         _RANDOM_START + "the sphere at rest at (0, 0, 1) m, 3 goals with course lengths, "
         "speeds, turn angles and time-critical shares drawn from the `point` preset.",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPoint-v0"))),
     ),
     EnvCard(
         "SGCPointGoal",
@@ -107,7 +146,7 @@ CARDS: tuple[EnvCard, ...] = (
         "`HerReplayBuffer`): a Dict observation and a sparse reward computed by "
         "`compute_reward`.",
         "As `SGCPoint-v0` (the same draws for the same seed).",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPointGoal-v0", goal=True))),
         gif_of="SGCPoint-v0",
     ),
     EnvCard(
@@ -117,7 +156,7 @@ CARDS: tuple[EnvCard, ...] = (
         "torques.",
         _RANDOM_START + "the rod at rest at (0, 0, 1) m, upright, 3 goals drawn from the "
         "`rod` preset (relative rotations on).",
-        (Version("v0", _FIRST),),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCRod-v0"))),
     ),
     EnvCard(
         "SGCThreeRods",
@@ -126,7 +165,8 @@ CARDS: tuple[EnvCard, ...] = (
         "three hit the bullseye board. One scene (25/16/17 goals).",
         "The three rods at the scene's launch poses, x about -9.2 m, flying at 2-2.5 m/s "
         "towards the board at x = 8 m; the balls at their start points. No noise.",
-        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT)),
+        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT),
+         Version("v2", _learner_version("SGCThreeRods-v1"))),
     ),
     EnvCard(
         "SGCThreeRodsRandom",
@@ -135,7 +175,8 @@ CARDS: tuple[EnvCard, ...] = (
         "times 1.0-1.4 s, hit times within 0.4 s of the paper's, ball velocities 0.5-1.2 m/s, "
         "and only draws whose bound of the plan's force and torque stays within 80 % of each "
         "limit.",
-        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT), Version("v2", _COURSE_BOUND)),
+        (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT), Version("v2", _COURSE_BOUND),
+         Version("v3", _learner_version("SGCThreeRodsRandom-v2"))),
     ),
 )
 
@@ -156,10 +197,18 @@ MEANING = {
     "position_flags": "(has a position track, current goal is the last)",
 }
 REWARDS = {
-    "schedule": "default. `-mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2) + "
+    "schedule": "`-mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2) + "
     "bonus`, with `D_sched = D_i(0) time_left / T_i` the course travelled on schedule (the "
     "paper's behaviour equation in its neutral member); a failure is charged the worst "
     "per-step reward for every step left.",
+    "tracking": "`mean_b sum_tracks 1 / (1 + |D - D_sched| / L) + 0.01 (1 - mean(a^2)) + "
+    "bonus`, no failure charge: the same on-schedule error as `schedule`, paid in a form a "
+    "learner can climb. `1 / (1 + x)` falls at every distance, where `min(x, 1)` is flat beyond "
+    "a course length (where an untrained body spends its first episodes); a step alive pays "
+    "between 0 and the number of tracks, so leaving the workspace loses the rest of the "
+    "episode's pay instead of one lump charge a value function has to predict. Undiscounted it "
+    "ranks policies that finish their episodes as `schedule` does, up to a constant per "
+    "scenario.",
     "distance": "`-mean_b(|D| / L + |phi| / A) - 0.01 mean(a^2) + bonus` (pays for arriving "
     "early and hovering; kept for comparison).",
     "sparse": "`-0.01 mean(a^2) + bonus`; a failure is charged 0.01 per step left.",
@@ -182,13 +231,13 @@ EPISODE_END = (
     "`info['spin_clamped']`, not terminal."
 )
 ARGUMENTS = (
-    "`gym.make(\"{env_id}\", ...)`: `reward` (`\"schedule\"`, `\"distance\"`, `\"sparse\"`), "
-    "`control_frequency` (Hz), `sim_frequency` (240 Hz, a multiple of it), `time_grid` "
-    "(`\"reject\"`, `\"snap\"`), `scenario` (a Scenario, built-in name or YAML path, instead "
-    "of the registered one), `render_mode` (`\"rgb_array\"`; `\"human\"` opens PyBullet's GUI "
-    "where a display exists), `width`/`height` (frame size, 640x480), `camera` (`\"fixed\"` "
-    "frames the whole scene, `\"tracking\"` follows the bodies, or a dict of `yaw`, `pitch`, "
-    "`fov`, `target` and `distance`). Registered with `{kwargs}`."
+    "`gym.make(\"{env_id}\", ...)`: `reward` ({rewards}), `observation` (`\"planner\"`, "
+    "`\"learner\"`), `control_frequency` (Hz), `sim_frequency` (240 Hz, a multiple of it), "
+    "`time_grid` (`\"reject\"`, `\"snap\"`), `scenario` (a Scenario, built-in name or YAML "
+    "path, instead of the registered one), `render_mode` (`\"rgb_array\"`; `\"human\"` opens "
+    "PyBullet's GUI where a display exists), `width`/`height` (frame size, 640x480), `camera` "
+    "(`\"fixed\"` frames the whole scene, `\"tracking\"` follows the bodies, or a dict of "
+    "`yaw`, `pitch`, `fov`, `target` and `distance`). Registered with `{kwargs}`."
 )
 
 
@@ -238,16 +287,74 @@ def _layout_table(n_bodies: int) -> list[str]:
     return rows
 
 
+def learner_rows() -> list[list[str]]:
+    """The per-track table of :mod:`sgc_env.envs.learner_view`'s docstring (its one home), as
+    cells with an offset column after the first; a ValueError if its sizes stop adding up to
+    :data:`~sgc_env.envs.learner_view.LEARNER_TRACK_SIZE`."""
+    doc = learner_view.__doc__ or ""
+    lines = [line.strip() for line in doc.splitlines() if line.strip().startswith("|")]
+    cells = [[c.strip().replace("``", "`") for c in line.strip("|").split("|")] for line in lines]
+    if len(cells) < 3 or "size" not in cells[0]:
+        raise ValueError("sgc_env.envs.learner_view: its docstring lost the per-track table")
+    at, offset, rows = cells[0].index("size"), 0, []
+    for row in cells[2:]:
+        rows.append([row[0], str(offset), *row[1:]])
+        offset += int(row[at])
+    if offset != LEARNER_TRACK_SIZE:
+        raise ValueError(f"sgc_env.envs.learner_view: the docstring's table sums to {offset} "
+                         f"entries per track, the view has {LEARNER_TRACK_SIZE}")  # fmt: skip
+    return [[cells[0][0], "offset (body 0)", *cells[0][1:]], *rows]
+
+
+LEARNER_TAIL = (
+    ("the action that hovers the body, `-m g / force_limit`", 2 * LEARNER_TRACK_SIZE, 3,
+     "action units, clipped to [-1, 1]", "gravity is not compensated: the feed-forward every "
+     "body needs, which differs by mass and force limit"),
+)  # fmt: skip
+LEARNER_NOTE = (
+    '"Squashed" is `3 tanh(x / 3)`: linear near the schedule, where the tolerances are (2 cm is '
+    "0.4 of a unit of 0.05 m), bounded when a body is far off it, so a network is never handed "
+    "inputs of 20-100. No absolute positions and no float32 precision residuals: a policy that "
+    "must be exact (the expert) reads the planner's view of the same state, "
+    "`env.unwrapped.planner_observation()` (`make_policy(\"expert\", env)` does so). Entries "
+    "of a track the body does not have are 0, as are the next-goal entries on the last goal."
+)
+
+
+def _learner_table(n_bodies: int) -> list[str]:
+    head, *rows = learner_rows()
+    width = len(head)
+    table = ["| " + " | ".join(head) + " |", "|" + "---|" * width]
+    table += ["| " + " | ".join(row) + " |" for row in rows]
+    for entry, offset, size, scale, why in LEARNER_TAIL:
+        table.append(f"| {entry} | {offset} | {size} | {scale} | {why} |")
+    table.append(f"| the episode's time fraction (once, after the bodies) | "
+                 f"{n_bodies * LEARNER_BODY_SIZE} | 1 | [0, 1] | the episode is finite: "
+                 "a time feature (Pardo et al.) |")  # fmt: skip
+    return table
+
+
 def _observation(env: Any) -> list[str]:
     base = env.unwrapped
     n = len(base.scenario.bodies)
+    goal = isinstance(env.observation_space, gym.spaces.Dict)
+    lines = [f"{_space(env.observation_space)}." if not goal else
+             "`Dict`: `observation` (the flat Box below), `achieved_goal` (4: body 0's tracked "
+             "point and the time), `desired_goal` (4: the current nail and its goal "
+             "time)."]  # fmt: skip
+    if base.observation_view == "learner":
+        lines[0] += (
+            f" The learner's view (`sgc_env/envs/learner_view.py`), tight float32 bounds per "
+            f"entry: {n} body block{'s' if n > 1 else ''} of {LEARNER_BODY_SIZE} entries (body b "
+            f"at offset b * {LEARNER_BODY_SIZE}): the position track (offsets below), the "
+            f"orientation track (the same entries from offset {LEARNER_TRACK_SIZE}, in rad), "
+            "the hovering action; then the episode's time fraction. Each entry is there because "
+            "the reward measures it or a tracker needs it to act on it:"
+        )
+        return [*lines, "", *_learner_table(n), "", LEARNER_NOTE]
     block = ObservationLayout(n).body_block_size
-    lines = [f"{_space(env.observation_space)}." if not isinstance(
-        env.observation_space, gym.spaces.Dict) else  # fmt: skip
-        "`Dict`: `observation` (the flat Box below), `achieved_goal` (4: body 0's tracked "
-        "point and the time), `desired_goal` (4: the current nail and its goal time)."]
-    lines[0] += (f" {n} body block{'s' if n > 1 else ''} of {block} entries (body b at offset "
-                 f"b * {block}), then `time`; read them by name through "
+    lines[0] += (f" The planner's view: {n} body block{'s' if n > 1 else ''} of {block} entries "
+                 f"(body b at offset b * {block}), then `time`; read them by name through "
                  "`env.unwrapped.layout` (`ObservationLayout`):")  # fmt: skip
     return [*lines, "", *_layout_table(n)]
 
@@ -255,7 +362,10 @@ def _observation(env: Any) -> list[str]:
 def _rewards(env: Any) -> list[str]:
     if isinstance(env.observation_space, gym.spaces.Dict):
         return [GOAL_REWARD]
-    return [f"- `{mode}`: {text}" for mode, text in REWARDS.items()] + ["", REWARD_TERMS]
+    default = env.unwrapped.reward_mode
+    modes = [default, *(mode for mode in REWARDS if mode != default)]
+    return [f"- `{mode}`{' (default)' if mode == default else ''}: {REWARDS[mode]}"
+            for mode in modes] + ["", REWARD_TERMS]  # fmt: skip
 
 
 def _episode_end(env_id: str) -> list[str]:
@@ -268,29 +378,49 @@ def _episode_end(env_id: str) -> list[str]:
 
 def _arguments(env_id: str) -> list[str]:
     kwargs = ", ".join(f"{k}={v!r}" for k, v in gym.spec(env_id).kwargs.items())
-    return [ARGUMENTS.format(env_id=env_id, kwargs=kwargs)]
+    rewards = ", ".join(f'`"{mode}"`' for mode in REWARDS)
+    return [ARGUMENTS.format(env_id=env_id, kwargs=kwargs, rewards=rewards)]
 
 
-def _gif(card: EnvCard) -> str:
-    if card.gif_of is None:
-        return f"![the expert on {card.env_id}]({gif_path(card.env_id)})"
-    return (f"![the expert on {card.gif_of}]({gif_path(card.gif_of)}) (the expert on "
-            f"`{card.gif_of}`: the same scenes and physics)")  # fmt: skip
+def _gif(card: EnvCard, env_id: str) -> str:
+    shown = card.gif_id
+    if shown == env_id:
+        return f"![the expert on {env_id}]({gif_path(env_id)})"
+    return (f"![the expert on {shown}]({gif_path(shown)}) (the expert on `{shown}`: the same "
+            "scenes and physics)")  # fmt: skip
 
 
-def card_markdown(card: EnvCard) -> str:
-    """One id's card (markdown, a ``###`` section)."""
-    env_id = card.env_id
-    env = gym.make(env_id)
+def _versions(card: EnvCard, env_id: str) -> list[str]:
+    """The card's version history; the other registered versions link to their pages."""
+    lines = []
+    for v in card.versions:
+        other = f"{card.name}-{v.version}"
+        if other == env_id:
+            label = f"{v.version} (this page)"
+        elif other in card.registered_ids:
+            label = f"[{v.version}]({other}.md)"
+        else:
+            label = f"{v.version} (no longer registered)"
+        lines.append(f"- {label}: {v.change}")
+    return lines
+
+
+def card_markdown(card: EnvCard, env_id: str | None = None) -> str:
+    """The card of one registered version of ``card`` (None: the newest; markdown, a ``###``
+    section)."""
+    env_id = env_id or card.env_id
+    with warnings.catch_warnings():  # Gymnasium's "out of date" notice: older pages on purpose
+        warnings.simplefilter("ignore", DeprecationWarning)
+        env = gym.make(env_id)
     sections: list[tuple[str, Sequence[str]]] = [
-        ("Description", [card.description, "", _gif(card)]),
+        ("Description", [card.description, "", _gif(card, env_id)]),
         ("Action Space", _action(env)),
         ("Observation Space", _observation(env)),
         ("Rewards", _rewards(env)),
         ("Starting State", [card.starting_state]),
         ("Episode End", _episode_end(env_id)),
         ("Arguments", _arguments(env_id)),
-        ("Version History", [f"- {v.version}: {v.change}" for v in card.versions]),
+        ("Version History", _versions(card, env_id)),
     ]
     env.close()
     lines = [f"### `{env_id}`", ""]
@@ -299,29 +429,42 @@ def card_markdown(card: EnvCard) -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
-def page_markdown(card: EnvCard) -> str:
+def page_markdown(card: EnvCard, env_id: str | None = None) -> str:
     """One id's card as a page of its own (``docs/envs/<id>.md``): headings one level up,
     the GIF path relative to that folder."""
-    text = card_markdown(card).replace(f"]({GIF_DIR}/", f"](../{GIF_DIR}/")
+    text = card_markdown(card, env_id).replace(f"]({GIF_DIR}/", f"](../{GIF_DIR}/")
     lines = [line[2:] if line.startswith("##") else line for line in text.splitlines()]
     return f"{GENERATED}\n\n" + "\n".join(lines) + "\n"
 
 
 def index_markdown() -> str:
     """The folder's index: the ids in ladder order, one line each."""
+    rows = ["| env | the benchmark's version: planner's view | the newest: learner's view |",
+            "|---|---|---|"]
+    for card in CARDS:
+        *older, newest = card.registered_ids
+        rows.append(f"| {card.name} | {', '.join(f'[{i}]({i}.md)' for i in older)} | "
+                    f"[{newest}]({newest}.md) |")  # fmt: skip
+    ids = [env_id for card in CARDS for env_id in card.registered_ids]
     lines = [GENERATED, "", "# Environment cards", "",
              "One card per registered id, in the sections Gymnasium's cards use; spaces, the "
              "observation layout, limits, episode lengths and registered arguments are read "
              "from the envs themselves. The ladder and what each rung tests: "
              "[environments](../environments.md).", "",
-             "```{toctree}", ":maxdepth: 1", "", *(card.env_id for card in CARDS), "```", ""]
+             "Every env has two registered versions with the same scenes and physics. The "
+             "benchmark's version observes the planner's view and pays the `schedule` reward "
+             "(the leaderboards, the shipped models and the scorecard use it); the newest "
+             "observes the learner's view and pays the `tracking` reward (the goal id: its own "
+             "sparse reward). Each card's version history says what changed.", "",
+             *rows, "", "```{toctree}", ":maxdepth: 1", "", *ids, "```", ""]  # fmt: skip
     return "\n".join(lines)
 
 
 def pages() -> dict[str, str]:
-    """File name -> text of every page of ``docs/envs``."""
+    """File name -> text of every page of ``docs/envs``: one per registered id."""
     out = {"index.md": index_markdown()}
-    out.update({f"{card.env_id}.md": page_markdown(card) for card in CARDS})
+    for card in CARDS:
+        out.update({f"{i}.md": page_markdown(card, i) for i in card.registered_ids})
     return out
 
 
@@ -348,4 +491,4 @@ if __name__ == "__main__":
         print(f"{args.write}: {len(changed)} page(s) updated" if changed else
               f"{args.write}: already up to date")  # fmt: skip
     else:
-        print("\n".join(card_markdown(card) for card in CARDS))
+        print("\n".join(card_markdown(card, i) for card in CARDS for i in card.registered_ids))

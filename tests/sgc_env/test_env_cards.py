@@ -5,37 +5,85 @@ from __future__ import annotations
 from pathlib import Path
 
 import gymnasium as gym
+import pytest
 
 import sgc_env
-from sgc_env.env_cards import CARDS, card_markdown, gif_path, pages
+from sgc_env.env_cards import CARDS, card_markdown, gif_path, learner_rows, pages
+from sgc_env.envs.learner_view import learner_bounds
 
 ROOT = Path(__file__).resolve().parents[2]
 SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards", "Starting State",
             "Episode End", "Arguments", "Version History")  # fmt: skip
 
 
-def test_every_registered_id_has_one_card_at_its_latest_version():
-    assert sorted(card.env_id for card in CARDS) == sorted(sgc_env.ENV_IDS)
+def test_every_registered_id_is_a_version_on_its_card():
+    """Each card's newest version is a learner's id, its version before it the benchmark's
+    id; no other SGC id is registered."""
+    assert sorted(card.env_id for card in CARDS) == sorted(sgc_env.LEARNER_IDS)
+    registered = [env_id for card in CARDS for env_id in card.registered_ids]
+    assert sorted(registered) == sorted(sgc_env.ENV_IDS + sgc_env.LEARNER_IDS)
     for card in CARDS:
-        assert gym.spec(card.env_id).name == card.name
+        assert card.registered_ids[-1] == card.env_id
+        assert card.registered_ids[-2] in sgc_env.ENV_IDS
+        assert all(gym.spec(i).name == card.name for i in card.registered_ids)
+
+
+def _card(env_id: str) -> str:
+    card = next(c for c in CARDS if env_id in c.registered_ids)
+    return card_markdown(card, env_id)
 
 
 def test_every_card_has_every_section_and_an_existing_gif():
     for card in CARDS:
-        text = card_markdown(card)
-        for section in SECTIONS:
-            assert f"#### {section}\n" in text, (card.env_id, section)
-        assert "- v0: " in text
-        shown = card.gif_of or card.env_id
-        gif = ROOT / "docs" / gif_path(shown)
+        for env_id in card.registered_ids:
+            text = card_markdown(card, env_id)
+            for section in SECTIONS:
+                assert f"#### {section}\n" in text, (env_id, section)
+            assert f"- {env_id.rsplit('-', 1)[1]} (this page): " in text
+            assert "- [v" in text  # the other registered version, linked
+        gif = ROOT / "docs" / gif_path(card.gif_id)
         assert gif.is_file() and gif.stat().st_size < 400_000, gif
 
 
 def test_cards_read_spaces_from_the_envs():
-    rod = card_markdown(next(c for c in CARDS if c.env_id == "SGCRod-v0"))
+    rod = _card("SGCRod-v0")
     assert "`Box(-1, 1, (6,), float32)`" in rod and "torque" in rod
-    goal = card_markdown(next(c for c in CARDS if c.env_id == "SGCPointGoal-v0"))
+    goal = _card("SGCPointGoal-v0")
     assert "`Dict`" in goal and "compute_reward" in goal
+
+
+@pytest.mark.parametrize(("old", "new"), [("SGCRod-v0", "SGCRod-v1"),
+                                          ("SGCThreeRodsRandom-v2", "SGCThreeRodsRandom-v3")])
+def test_the_versions_say_which_view_and_reward_they_have(old: str, new: str):
+    """The benchmark's version: the planner's layout and `schedule` by default; the newest:
+    the learner's table (each entry with its why) and `tracking` by default, explained; both
+    pages tell what changed between them."""
+    before, after = _card(old), _card(new)
+    assert "The planner's view" in before and "`position_deviation`" in before
+    assert "- `schedule` (default)" in before and "- `tracking`: " in before
+    assert "The learner's view" in after and "`position_deviation`" not in after
+    assert "| on-schedule error `D - D_sched` | 0 | 3 |" in after
+    assert "| what the reward charges |" in after and "time feature" in after
+    assert "- `tracking` (default): " in after and "falls at every distance" in after
+    change = f"`{old}` keeps the planner's view and its reward"
+    assert change in before and change in after
+
+
+def test_the_learner_table_matches_the_views_bounds():
+    """The table (read from the view's docstring, its one home) puts each entry where the
+    view's bounds say its range is: squashed entries within +-3, the course fraction and the
+    flags in [0, 1], the times in [-1, 3]."""
+    head, *rows = learner_rows()
+    assert head[:3] == ["entry", "offset (body 0)", "size"]
+    low, high = learner_bounds(1)
+    scale = head.index("scale")
+    for row in rows:
+        at, size = int(row[1]), int(row[2])
+        text = row[scale]
+        expected = ((-3.0, 3.0) if "squashed" in text else (-1.0, 3.0) if "[-1, 3]" in text
+                    else (0.0, 1.0))  # fmt: skip
+        for k in range(at, at + size):
+            assert (low[k], high[k]) == expected, (row[0], k)
 
 
 def test_the_env_pages_are_what_the_cards_generate():
