@@ -140,7 +140,9 @@ def imitation_loss(model: BaseAlgorithm, demos: Demonstrations) -> float:
 def _label_rollouts(
     model: BaseAlgorithm, env: gym.Env, expert: Any, seeds: np.ndarray, pushes: Pushes
 ) -> tuple[np.ndarray, np.ndarray]:
-    """States visited by the model's deterministic policy, labelled with the expert's action.
+    """States visited by the model's deterministic policy, labelled with the expert's action
+    (on a learner's id: its action on the env's planner view of the state, through
+    :func:`~baselines.policies.make_policy`).
 
     A push replaces the state before it is labelled, so the expert's recovery is learned.
     """

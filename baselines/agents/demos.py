@@ -167,7 +167,9 @@ def record_demos(
     """Roll out ``policy`` on seeds ``seed .. seed+episodes-1``.
 
     The default policy is the harness's ``expert`` (an :class:`SGCExpert` rebuilt at every
-    episode start, because random scenarios redraw the force limits on reset). With
+    episode start, because random scenarios redraw the force limits on reset); on an env of the
+    learner's view it acts on the env's planner view of the same state
+    (:mod:`baselines.common.planner_view`), and the file stores the env's own observation. With
     ``pushes``, a pushed step records the observation after the push and the action taken on
     it, which for the expert is the recovery from the push.
     """
