@@ -15,16 +15,16 @@ from typing import Any
 
 import numpy as np
 
-from baselines.common.sub_envs import is_vector
+from baselines.common.sub_envs import is_vector, sub_env
 
 __all__ = ["OnPlannerView", "observed_view", "planner_observation"]
 
 
 def observed_view(env: Any) -> str:
-    """The name of the view ``env`` (or a vector env's first reachable sub-env) observes;
-    ``"planner"`` where nothing says otherwise (sub-envs behind processes)."""
-    first = getattr(env, "envs", [env])[0]
-    return getattr(getattr(first, "unwrapped", first), "observation_view", "planner")
+    """The name of the view ``env`` (or a vector env's first sub-env, in process or behind
+    processes) observes; ``"planner"`` for an env that does not say (not an SGC env: the
+    policy's own checks name it)."""
+    return getattr(sub_env(env, 0).unwrapped, "observation_view", "planner")
 
 
 def _base_planner_observation(env: Any) -> np.ndarray:
@@ -62,8 +62,11 @@ class OnPlannerView:
     def __init__(self, policy: Any, env: Any) -> None:
         self.policy = policy
         self.env = env
-        space = getattr(env, "observation_space", None)
-        self._shape = getattr(space, "shape", None)
+        if is_vector(env):  # Gymnasium's batched spaces have single ones; SB3's are single
+            single = getattr(env, "single_observation_space", None) or env.observation_space
+            self._shape: tuple[int, ...] = (env.num_envs, *single.shape)
+        else:
+            self._shape = env.observation_space.shape
 
     def predict(
         self,
@@ -73,7 +76,7 @@ class OnPlannerView:
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
         shape = np.shape(observation)
-        if self._shape is not None and shape != self._shape:
+        if shape != self._shape:
             raise ValueError(
                 f"observation has shape {shape}; this policy acts on the current state of an env "
                 f"whose observations have shape {self._shape}"

@@ -23,6 +23,7 @@ MODEL_ATTRIBUTES = (
     "sim_frequency",
     "substeps",
     "use_torque",
+    "observation_view",
 )
 """What a model-based policy reads from the base env (fetched across processes by name)."""
 

@@ -3,6 +3,8 @@ through single, Gymnasium-batched and SB3-batched envs, and planner policies act
 
 from __future__ import annotations
 
+from typing import Any
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -66,22 +68,39 @@ def test_batched_env_hands_out_one_planner_row_per_sub_env(num_envs: int) -> Non
     planner.close()
 
 
-def test_sb3_vector_envs_hand_out_planner_rows() -> None:
-    pytest.importorskip("stable_baselines3")
-    from stable_baselines3.common.vec_env import DummyVecEnv
+def _vector(kind: str) -> Any:
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
     from baselines.agents.sb3_vec_env import make_sgc_vec
 
-    for vec in (DummyVecEnv([lambda: gym.make("SGCRod-v1")] * 2),
-                make_sgc_vec("SGCRod-v1", 2, 5, {}, "batched")):  # fmt: skip
+    if kind == "batched":
+        return make_sgc_vec("SGCRod-v1", 2, 5, {}, "batched")
+    # "sgc_env:<id>" imports sgc_env in a fresh worker process before making it
+    make = {"DummyVecEnv": DummyVecEnv, "SubprocVecEnv": SubprocVecEnv,
+            "AsyncVectorEnv": gym.vector.AsyncVectorEnv}[kind]  # fmt: skip
+    return make([lambda: gym.make("sgc_env:SGCRod-v1")] * 2)
+
+
+@pytest.mark.parametrize("kind", ["DummyVecEnv", "batched", "SubprocVecEnv", "AsyncVectorEnv"])
+def test_vector_envs_in_and_out_of_process_hand_out_planner_rows(kind: str) -> None:
+    pytest.importorskip("stable_baselines3")
+    vec = _vector(kind)
+    if isinstance(vec, gym.vector.VectorEnv):
+        vec.reset(seed=5)
+    else:
         vec.seed(5)
         vec.reset()
-        rows = planner_observation(vec)
-        single = gym.make("SGCRod-v1", observation="planner")
-        assert rows.shape == (2, single.observation_space.shape[0])
-        for i in range(2):
-            assert np.array_equal(rows[i], single.reset(seed=5 + i)[0])
-        vec.close()
+    rows = planner_observation(vec)
+    single = gym.make("SGCRod-v1", observation="planner")
+    assert rows.shape == (2, single.observation_space.shape[0])
+    for i in range(2):
+        assert np.array_equal(rows[i], single.reset(seed=5 + i)[0])
+    assert observed_view(vec) == "learner"
+    policy = make_policy("expert", vec)  # the view is read across processes too
+    assert isinstance(policy, OnPlannerView)
+    reference = make_policy("expert", gym.make("SGCRod-v1", observation="planner"))
+    assert np.array_equal(policy.predict(np.zeros((2, 50)))[0], reference.predict(rows)[0])
+    vec.close()
 
 
 def test_make_policy_puts_the_expert_on_the_planner_view() -> None:
