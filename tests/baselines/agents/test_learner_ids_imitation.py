@@ -103,3 +103,12 @@ def test_behaviour_cloning_trains_on_the_learners_view(tmp_path: Path) -> None:
     assert result.bc is not None
     assert result.bc["loss_after"] < 0.5 * result.bc["loss_before"]
     assert result.bc["samples_after_dagger"] > result.bc["samples"]
+    assert result.model.get_env().gamma == 0.98  # rl-zoo3's normalize: gamma, as written
+
+
+def test_normalize_gamma_out_of_range_names_the_field(tmp_path: Path) -> None:
+    from baselines.agents.hyperparams import load_hyperparams
+
+    (tmp_path / "ppo.yml").write_text(TINY_PPO.replace("gamma=0.98", "gamma=1.5"))
+    with pytest.raises(ValueError, match="SGCPoint-v1: normalize: gamma must be in"):
+        load_hyperparams("ppo", "SGCPoint-v1", tmp_path)
