@@ -122,7 +122,7 @@ def test_benchmark_recipe_resolves_the_features_and_reward_only_normalisation() 
 
 @pytest.mark.parametrize(
     ("value", "match"),
-    [("'dict(norm_obs=False, gamma=1)'", "unknown keys"), ("3", "true/false or a mapping")],
+    [("'dict(norm_obs=False, norm_obz=True)'", "unknown keys"), ("3", "true/false or a mapping")],
 )
 def test_normalize_field_errors_name_it(tmp_path: Path, value: str, match: str) -> None:
     (tmp_path / "ppo.yml").write_text(
