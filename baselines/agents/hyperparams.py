@@ -162,7 +162,7 @@ def _learning_rate(value: Any) -> Any:
                      f"{escaped(repr(value))}")  # fmt: skip
 
 
-_NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward", "gamma")
+_NORMALIZE_KEYS = ("norm_obs", "norm_reward", "clip_obs", "clip_reward", "gamma", "epsilon")
 
 
 def _normalize(value: Any, where: str) -> tuple[bool, dict[str, Any]]:
@@ -180,8 +180,9 @@ def _normalize(value: Any, where: str) -> tuple[bool, dict[str, Any]]:
         kind = bool if key.startswith("norm_") else float
         if not matches(item, kind):
             raise ValueError(f"{where}: normalize: {key} must be {describe(kind)}, got {item!r}")
-        if key == "gamma" and not 0.0 < item <= 1.0:
-            raise ValueError(f"{where}: normalize: gamma must be in (0, 1], got {item!r}")
+        if kind is float and not (0.0 < item <= (1.0 if key == "gamma" else math.inf)):
+            limit = "in (0, 1]" if key == "gamma" else "> 0"
+            raise ValueError(f"{where}: normalize: {key} must be {limit}, got {item!r}")
     return True, dict(value)
 
 

@@ -174,9 +174,10 @@ def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
 
         env = SmoothScheduleCost(env, alive=hp.reward_shaping == "smooth_alive")
     if hp.normalize:
-        # rl-zoo3's rule: the reward is normalised with the algorithm's gamma unless given
-        env = VecNormalize(env, **{"gamma": hp.algo_kwargs.get("gamma", 0.99),
-                                   **hp.normalize_kwargs})  # fmt: skip
+        # rl-zoo3's rule: the reward's running return uses the algorithm's gamma unless the
+        # file's normalize gives its own
+        settings = {"gamma": hp.algo_kwargs.get("gamma", 0.99), **hp.normalize_kwargs}
+        env = VecNormalize(env, **settings)
     kwargs = dict(hp.algo_kwargs)
     if cfg.init == "bc":
         from baselines.models.features import StandardizeObservation

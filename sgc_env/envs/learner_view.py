@@ -66,23 +66,26 @@ def _cols(name: str) -> slice:
     return _L.body_slice(0, name)
 
 
-_TRACKS = tuple(
-    (
-        _cols(deviation),
-        _cols(rate),
-        _cols(f"{track}_time_left").start,
-        _cols(f"{track}_course_start"),
-        _cols(f"{track}_course_duration").start,
-        _cols(f"{track}_next_start"),
-        _cols(f"{track}_next_duration").start,
-        _cols(f"{track}_end_velocity"),
-        _cols(f"{track}_flags"),
-    )
+def _gather(*fields: str) -> np.ndarray:
+    """Block columns of ``fields`` (position track's then orientation track's), (2, columns)."""
+    out = []
     for track, deviation, rate in (
         ("position", "position_deviation", "point_velocity"),
         ("orientation", "orientation_deviation", "angular_velocity"),
-    )
+    ):
+        names = [f.format(track=track, deviation=deviation, rate=rate) for f in fields]
+        out.append(np.concatenate([np.r_[_cols(name)] for name in names]))
+    return np.array(out)
+
+
+# The columns both tracks read, gathered by one fancy index each (N, bodies, 2, width): the
+# view costs numpy's per-call overhead, so the two tracks share every call.
+_VECTORS = _gather(
+    "{deviation}", "{rate}", "{track}_course_start", "{track}_next_start", "{track}_end_velocity"
 )
+_SCALARS = _gather("{track}_time_left", "{track}_course_duration", "{track}_next_duration")
+_FLAGS = _gather("{track}_flags")
+_SCALES = np.array([ERROR_SCALE] * 3 + [RATE_SCALE] * 3 + [VELOCITY_SCALE] * 6 + [GOAL_SCALE] * 6)
 
 
 def learner_size(n_bodies: int) -> int:
@@ -106,13 +109,14 @@ def _squash(x: np.ndarray) -> np.ndarray:
     return SQUASH * np.tanh(x / SQUASH)
 
 
-def _track(block: np.ndarray, cols: tuple) -> list[np.ndarray]:
-    """The 23 entries of one track of every (row, body) of ``block`` (N, bodies, block)."""
-    dev, rate, left, start, duration, next_start, next_duration, end_velocity, flags = cols
-    d, r, t = block[..., dev], block[..., rate], block[..., left]
-    c0, span = block[..., start], block[..., duration]
-    c1, next_span = block[..., next_start], block[..., next_duration]
-    v_end, flag = block[..., end_velocity], block[..., flags]
+def _tracks(block: np.ndarray) -> np.ndarray:
+    """The 23 entries of both tracks of every (row, body) of ``block`` (N, bodies, block):
+    (N, bodies, 2, 23), position track first."""
+    vectors = block[..., _VECTORS].reshape(*block.shape[:-1], 2, 5, 3)
+    d, r, c0, c1, v_end = (vectors[..., k, :] for k in range(5))
+    scalars = block[..., _SCALARS]
+    t, span, next_span = scalars[..., 0], scalars[..., 1], scalars[..., 2]
+    flag = block[..., _FLAGS]
     has = flag[..., 0:1]
     in_course = ((t >= 0.0) & (span > 0.0))[..., None]
     safe_span = np.where(span > 0.0, span, 1.0)[..., None]
@@ -121,21 +125,21 @@ def _track(block: np.ndarray, cols: tuple) -> list[np.ndarray]:
     schedule_rate = np.where(in_course, -c0 / safe_span, v_end)
     has_next = (next_span > 0.0)[..., None]
     next_rate = np.where(has_next, -c1 / np.where(has_next, next_span[..., None], 1.0), 0.0)
-    goal = -d
     next_goal = np.where(has_next, -(d + c1), 0.0)
     next_time = np.where(has_next[..., 0], t + next_span, 0.0)
+    raw = np.concatenate(
+        (d - schedule, r - schedule_rate, schedule_rate, next_rate, -d, next_goal), axis=-1
+    )
     times = np.stack((t, next_time), axis=-1)
-    return [
-        has * _squash((d - schedule) / ERROR_SCALE),
-        has * _squash((r - schedule_rate) / RATE_SCALE),
-        has * _squash(schedule_rate / VELOCITY_SCALE),
-        has * _squash(next_rate / VELOCITY_SCALE),
-        has * _squash(goal / GOAL_SCALE),
-        has * _squash(next_goal / GOAL_SCALE),
-        has * np.where(in_course, np.clip(fraction, 0.0, 1.0), 0.0),
-        has * np.clip(times, TIME_LOW, TIME_HIGH),
-        flag,
-    ]
+    return np.concatenate(
+        (
+            has * _squash(raw / _SCALES),
+            has * np.where(in_course, np.minimum(np.maximum(fraction, 0.0), 1.0), 0.0),
+            has * np.minimum(np.maximum(times, TIME_LOW), TIME_HIGH),
+            flag,
+        ),
+        axis=-1,
+    )
 
 
 def learner_observation(
@@ -150,9 +154,10 @@ def learner_observation(
     if block.ndim != 3 or block.shape[-1] != BODY_BLOCK_SIZE:
         raise ValueError(f"learner_observation: expected (N, bodies, {BODY_BLOCK_SIZE}) record")
     n, b = block.shape[:2]
-    parts = _track(block, _TRACKS[0]) + _track(block, _TRACKS[1]) + [np.clip(hover, -1.0, 1.0)]
-    bodies = np.concatenate(parts, axis=-1).reshape(n, b * LEARNER_BODY_SIZE)
-    fraction = np.clip(episode_fraction, 0.0, 1.0).reshape(n, 1)
+    tracks = _tracks(block).reshape(n, b, 2 * LEARNER_TRACK_SIZE)
+    hover = np.minimum(np.maximum(hover, -1.0), 1.0)
+    bodies = np.concatenate((tracks, hover), axis=-1).reshape(n, -1)
+    fraction = np.minimum(np.maximum(episode_fraction, 0.0), 1.0).reshape(n, 1)
     return np.concatenate((bodies, fraction), axis=-1).astype(np.float32)
 
 

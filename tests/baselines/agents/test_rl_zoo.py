@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -87,3 +88,14 @@ def test_rl_zoo3_model_on_the_newest_rod_scores_through_the_harness(tmp_path: Pa
     assert stats.with_suffix(".json").is_file() and not stats.exists()
     result = evaluate(str(model_file), "SGCRod-v1", episodes=1, seed=20000)
     assert result.summary["episodes"] == 1
+    table = subprocess.run(
+        [sys.executable, "scripts/zoo_seed_table.py", str(model_file.parent), "--episodes", "1",
+         "--json", str(tmp_path / "rows.json")],
+        capture_output=True, text=True, timeout=300, cwd=Path(__file__).resolve().parents[3],
+    )  # fmt: skip
+    assert table.returncode == 0, table.stderr[-2000:]
+    (row,) = json.loads((tmp_path / "rows.json").read_text())
+    assert (row["env_id"], row["seed"], row["steps"]) == ("SGCRod-v1", 0, 256)
+    assert row["n_goals"] == result.summary["n_goals"] and row["training_s"] > 0
+    met = int(row["success_rate"] >= 0.8)
+    assert f"{met}/1 runs meet >= 80% of held-out goals" in table.stdout

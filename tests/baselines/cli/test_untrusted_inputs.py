@@ -36,6 +36,8 @@ HYPERPARAMS = {
     "  policy_kwargs: {net_arch: x}\n": "policy_kwargs.net_arch: expected a list of layer",
     "  normalize: 'dict(clip_obs=\"x\")'\n": "normalize: clip_obs must be a finite number",
     "  normalize: {norm_obs: 1}\n": "normalize: norm_obs must be true/false",
+    "  normalize: 'dict(gamma=1.5)'\n": "normalize: gamma must be in (0, 1], got 1.5",
+    "  normalize: 'dict(clip_reward=-1.0)'\n": "normalize: clip_reward must be > 0",
     "  policy: [MlpPolicy]\n": "policy must be a name",
 }
 
