@@ -23,7 +23,8 @@ and once the episode's time fraction (Pardo et al.'s time feature: the episode i
 "Squashed" is ``c tanh(x / c)`` with ``c = 3``: linear near the schedule, where the
 tolerances are (2 cm is 0.4 of a unit), bounded when a body is far off it, so an MLP is never
 handed inputs of 20-100. No absolute positions, no precision residuals: a policy that must be
-exact to 1e-15 (the expert) reads the planner's view, which the env keeps in its ``info``.
+exact to 1e-15 (the expert) reads the planner's view of the same state, which every env hands
+out as ``env.unwrapped.planner_observation()``.
 
 The view is computed from the step's double-precision record (one row per sub-env) and the
 sub-env's :meth:`LearnerView.constants` (the hovering action, the episode's length), so the
