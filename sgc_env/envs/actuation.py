@@ -53,8 +53,8 @@ def body_drive(
     over sub-envs for the batched env): the force and torque (world frame) from its action
     entries, force xyz then torque xyz (no torque for 3 entries), and its state at the step's
     start; and the centre of mass before each substep under semi-implicit Euler,
-    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``), where
-    the force acts."""
+    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``; the
+    batch passes one pair of arrays over the substeps), where the force acts."""
     fx, fy, fz = action[0] * force_limit, action[1] * force_limit, action[2] * force_limit
     torque = None
     if len(action) == 6:

@@ -68,7 +68,9 @@ def atan2(y: Value, x: Value) -> Value:
     """``math.atan2``, per element on arrays (libm's result, as for one value)."""
     if y.__class__ is not np.ndarray:
         return math.atan2(y, x)
-    out = list(map(math.atan2, y.ravel().tolist(), np.broadcast_to(x, y.shape).ravel().tolist()))
+    if x.__class__ is not np.ndarray or x.shape != y.shape:
+        x = np.broadcast_to(x, y.shape)
+    out = list(map(math.atan2, y.ravel().tolist(), x.ravel().tolist()))
     return np.array(out, dtype=np.float64).reshape(y.shape)
 
 

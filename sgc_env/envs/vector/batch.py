@@ -168,9 +168,9 @@ class Batch:
         shape = (len(self._envs), *self.action_shape)
         if a.shape != shape:
             raise ValueError(f"actions have shape {a.shape}, expected {shape} (num_envs, action)")
-        rows = a[indices]
+        rows = a if len(indices) == len(self._envs) else a[indices]  # sorted, distinct indices
         if a.dtype.kind in "fiu" and np.isfinite(rows).all():
-            return np.clip(rows, -1, 1)  # as clip_action, one call for all rows
+            return np.minimum(np.maximum(rows, -1), 1)  # as clip_action, for all rows at once
         out = []  # something is wrong: find the first bad row with the single env's check
         for i in indices:
             try:

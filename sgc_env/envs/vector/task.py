@@ -77,8 +77,12 @@ _SCALARS = ("has_offset", "has_pos", "has_ori", "ptime", "otime", "ptl", "otl", 
 def _put(store: np.ndarray, values: Any, sel: Any) -> None:
     """Write a rule's components (arrays over (bodies, rows), or floats) into the rows ``sel``
     of a (components, bodies, sub-envs) array."""
-    for row, value in zip(store, values, strict=True):
-        row[:, sel] = value
+    if sel.__class__ is slice:  # every row
+        for row, value in zip(store, values, strict=True):
+            row[...] = value
+    else:
+        for row, value in zip(store, values, strict=True):
+            row[:, sel] = value
 
 
 def _column(store: np.ndarray, i: int) -> list[tuple]:
@@ -98,7 +102,8 @@ class BatchTask:
         self.record_size = first._record.size // 8
         self.use_torque = first.use_torque
         self.substeps = first.substeps
-        self.coef = list(first._actuation._coef)
+        # One pair of (substeps, 1, 1) arrays: the rule's path over every substep in one pass.
+        self.coef = [tuple(np.array(c)[:, None, None] for c in zip(*first._actuation._coef))]
         self.reward = first._reward
         self.view = first._view
         z = np.zeros
@@ -247,8 +252,11 @@ class BatchTask:
         n = self.n
         every = len(rows) == n
         sel: Any = slice(None) if every else np.asarray(rows, dtype=np.intp)
-        actions = np.zeros((n, values.shape[1]))
-        actions[sel] = values
+        if every:
+            actions = values
+        else:
+            actions = np.zeros((n, values.shape[1]))
+            actions[sel] = values
         with np.errstate(all="ignore"):
             forces, torques, paths = self._drives(actions)
         self._physics(rows, sel, forces, torques, paths)
@@ -263,7 +271,7 @@ class BatchTask:
 
     def _drives(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
         """The actuation rule on every sub-env: forces and torques (3, bodies, N; torques
-        None without them), the CoM paths (substeps, 3, bodies, N); sets the applied record."""
+        None without them), the CoM paths (3, substeps, bodies, N); sets the applied record."""
         n, b = self.n, self.b
         a = np.ascontiguousarray(actions.reshape(n, b, -1).transpose(2, 1, 0))
         pos, orn, lin, _ = self._whole["state"]
@@ -280,7 +288,7 @@ class BatchTask:
             applied[:, 1] = torques.T
         else:
             applied[:, 1] = 0.0
-        return forces, torques, np.array(path)
+        return forces, torques, np.array(path[0])
 
     def _physics(
         self,
@@ -311,7 +319,7 @@ class BatchTask:
         minus, world = [-1] * count, [pb.WORLD_FRAME] * count
         f = forces[..., sel].reshape(3, count).T.tolist()
         tq = None if torques is None else torques[..., sel].reshape(3, count).T.tolist()
-        p = paths[..., sel].reshape(len(paths), 3, count).transpose(0, 2, 1).tolist()
+        p = paths[..., sel].reshape(3, self.substeps, count).transpose(1, 2, 0).tolist()
         force, torque, step = pb.applyExternalForce, pb.applyExternalTorque, pb.stepSimulation
         for pk in p:
             for _ in map(force, uids, minus, f, pk, world, clients):
