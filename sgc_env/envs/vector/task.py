@@ -103,7 +103,10 @@ class BatchTask:
         self.use_torque = first.use_torque
         self.substeps = first.substeps
         # One pair of (substeps, 1, 1) arrays: the rule's path over every substep in one pass.
-        self.coef = [tuple(np.array(c)[:, None, None] for c in zip(*first._actuation._coef))]
+        kh, c = (
+            np.array(column)[:, None, None] for column in zip(*first._actuation._coef, strict=True)
+        )
+        self.coef = [(kh, c)]
         self.reward = first._reward
         self.view = first._view
         z = np.zeros
@@ -414,7 +417,10 @@ class BatchTask:
             self.tracks(), self.b, square_sum(actions), actions.shape[1], bonus, self.failed,
             self.max_steps - self.tick,
         )  # fmt: skip
-        return np.broadcast_to(self.reward.reward(score), (self.n,)).astype(np.float64)
+        reward = self.reward.reward(score)
+        if reward.__class__ is np.ndarray and reward.shape == (self.n,):
+            return reward.astype(np.float64)  # a copy: the mode's array may be kept elsewhere
+        return np.broadcast_to(reward, (self.n,)).astype(np.float64)
 
     def _record(self) -> None:
         """This step's record (N, record) and observation (the view's), in fresh buffers."""
