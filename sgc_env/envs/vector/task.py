@@ -27,6 +27,7 @@ already handed out copies them first.
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -332,10 +333,13 @@ class BatchTask:
                     pass
             for c in worlds:
                 step(c)
-        poses = map(pb.getBasePositionAndOrientation, uids, clients)
-        speeds = map(pb.getBaseVelocity, uids, clients)
-        read = [p + o + v + w for (p, o), (v, w) in zip(poses, speeds, strict=True)]
-        self.state[..., sel] = np.array(read).T.reshape(13, b, -1)
+        flat = chain.from_iterable  # the floats of every (position, orientation) pair, in turn
+        poses = flat(flat(map(pb.getBasePositionAndOrientation, uids, clients)))
+        speeds = flat(flat(map(pb.getBaseVelocity, uids, clients)))
+        pose = np.fromiter(poses, np.float64, 7 * count).reshape(count, 7)
+        speed = np.fromiter(speeds, np.float64, 6 * count).reshape(count, 6)
+        self.state[0:7][..., sel] = pose.T.reshape(7, b, -1)
+        self.state[7:13][..., sel] = speed.T.reshape(6, b, -1)
 
     def measure(self, sel: Any) -> None:
         """The measurement rule (:func:`~sgc_env.envs.measure.measure`) on the rows ``sel``."""
