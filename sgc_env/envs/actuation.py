@@ -47,7 +47,7 @@ def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
 def body_drive(
     action: Sequence[Any], position: Sequence[Any], orientation: Sequence[Any],
     velocity: Sequence[Any], force_limit: Any, torque_scale: Sequence[Any], mass: Any,
-    gravity: Sequence[float], coef: Sequence[tuple[float, float]],
+    gravity: Sequence[Any], coef: Sequence[tuple[Any, Any]],
 ) -> tuple[tuple, tuple | None, list[tuple]]:  # fmt: skip
     """One body's control period, the actuation rule of both envs (floats for one env, arrays
     over sub-envs for the batched env): the force and torque (world frame) from its action

@@ -86,7 +86,7 @@ def _put(store: np.ndarray, values: Any, sel: Any) -> None:
             row[:, sel] = value
 
 
-def _column(store: np.ndarray, i: int) -> list[tuple]:
+def _column(store: np.ndarray, i: int) -> list[Any]:
     """Sub-env ``i``'s per-body tuples of a (components, bodies, sub-envs) array."""
     return list(map(tuple, store[..., i].T.tolist()))
 
