@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE
+from sgc_env.paper.elementwise import any_
 from sgc_env.simulator import BodyReading, pybullet
 
 from ..actuation import body_drive
@@ -359,7 +360,7 @@ class BatchTask:
         """Each due sub-env's own ``GoalTask.advance`` (goal ticks are rare); the sub-envs
         whose goals changed are measured again, as ``SGCEnv._observe(read=False)`` does."""
         due = (self.tick >= self.next_event) & (self.next_event >= 0)
-        if not due.any():
+        if not any_(due):
             return {}
         if len(rows) < self.n:
             stepping = np.zeros(self.n, dtype=bool)
