@@ -195,7 +195,10 @@ class Batch:
         rewards, terminated, at_limit, events = fast.step(indices, values)
         self._behind = True
         truncated = ~terminated & at_limit
-        self.elapsed[indices] += 1
+        if len(indices) == len(self._envs):  # sorted, distinct indices: every sub-env
+            self.elapsed += 1
+        else:
+            self.elapsed[indices] += 1
         if self.limit is not None:
             truncated |= self.elapsed >= self.limit
         return rewards, terminated, truncated, events

@@ -377,11 +377,12 @@ class BatchTask:
                 events[i] = happened
             if moved:
                 self.load_goals(i)
-                self.phi[..., i].T[...] = task.phi
                 changed.append(i)
             else:
                 self.next_event[i] = task.next_event
         if len(changed) > SCALAR_MEASURE_ROWS:
+            for i in changed:  # phi moved on with the goal: the rule unwraps next to it
+                self.phi[..., i].T[...] = self.envs[i].task.phi
             self.measure(np.asarray(changed, dtype=np.intp))
         else:  # the same rule on floats: an array pass over a few rows costs more
             for i in changed:
