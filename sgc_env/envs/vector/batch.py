@@ -211,7 +211,7 @@ class Batch:
         for i, v in zip(indices, values, strict=True):
             d, moves = envs[i]._drives(v)
             by_world.setdefault(envs[i].sim.client, []).extend(d)
-            if moves:  # props: where the step leaves them (see BatchTask._place_props)
+            if moves:  # props: where the step leaves them (once, see BatchTask.sync)
                 for uid, spot in moves[-1]:
                     envs[i].sim.move(uid, spot)
         for world in self.worlds:

@@ -2,8 +2,8 @@
 
 Why: with N sub-envs in one world the physics is a small part of a step; the rest would be N
 times the single env's per-body Python. :class:`BatchTask` holds every sub-env's state in
-(N, bodies, ...) arrays and calls the very rules the single env calls, with arrays over
-(sub-envs, bodies) where the single env passes one body's floats: actuation
+arrays and calls the very rules the single env calls, with arrays over (bodies, sub-envs)
+where the single env passes one body's floats: actuation
 (:func:`~sgc_env.envs.actuation.body_drive`),
 measurement (:func:`~sgc_env.envs.measure.measure`), failure
 (:func:`~sgc_env.envs.failure.body_flags`), the reward mode (its one ``reward`` method), the
