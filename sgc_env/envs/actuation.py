@@ -47,14 +47,14 @@ def clip_action(action: object, shape: tuple[int, ...]) -> list[float]:
 def body_drive(
     action: Sequence[Any], position: Sequence[Any], orientation: Sequence[Any],
     velocity: Sequence[Any], force_limit: Any, torque_scale: Sequence[Any], mass: Any,
-    gravity: Sequence[float], coef: Sequence[tuple[float, float]],
+    gravity: Sequence[Any], coef: Sequence[tuple[Any, Any]],
 ) -> tuple[tuple, tuple | None, list[tuple]]:  # fmt: skip
     """One body's control period, the actuation rule of both envs (floats for one env, arrays
     over sub-envs for the batched env): the force and torque (world frame) from its action
     entries, force xyz then torque xyz (no torque for 3 entries), and its state at the step's
     start; and the centre of mass before each substep under semi-implicit Euler,
-    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``), where
-    the force acts."""
+    ``x + k h v + h^2 a k (k + 1) / 2`` (``coef`` holds ``(k h, h^2 k (k + 1) / 2)``; the
+    batch passes one pair of arrays over the substeps), where the force acts."""
     fx, fy, fz = action[0] * force_limit, action[1] * force_limit, action[2] * force_limit
     torque = None
     if len(action) == 6:

@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from sgc_env.paper.elementwise import where, where3
+from sgc_env.paper.elementwise import all_, any_, where, where3
 from sgc_env.paper.quaternion import log, mul_conjugate, rotate, unwrap_rotvec
 
 Vec = Sequence[Any]  # components: floats for one env, arrays for the batch
@@ -36,15 +36,15 @@ def measure(
     """One body's measurement (module docstring); ``state`` is (position, orientation xyzw,
     velocity, angular velocity), each a tuple of components."""
     pos, orn, lin, ang = state
-    # "x is True or x is not False and x.any()": any_(x) inline (module sgc_env.paper.elementwise)
-    if has_offset is True or has_offset is not False and has_offset.any():
+    # "x is True or x is not False and any_(x)": one value tested inline (sgc_env.paper.elementwise)
+    if has_offset is True or has_offset is not False and any_(has_offset):
         lever: Any = rotate(orn, offset)
         point = (pos[0] + lever[0], pos[1] + lever[1], pos[2] + lever[2])
-        if has_offset is not True and not has_offset.all():
+        if has_offset is not True and not all_(has_offset):
             lever, point = where3(has_offset, lever, offset), where3(has_offset, point, pos)
     else:
         lever, point = offset, pos
-    if has_position is True or has_position is not False and has_position.any():
+    if has_position is True or has_position is not False and any_(has_position):
         wx, wy, wz = ang
         rx, ry, rz = lever
         deviation = (
@@ -52,15 +52,15 @@ def measure(
             lin[0] + wy * rz - wz * ry, lin[1] + wz * rx - wx * rz, lin[2] + wx * ry - wy * rx,
         )  # fmt: skip
         left = position_time - time
-        if has_position is not True and not has_position.all():
+        if has_position is not True and not all_(has_position):
             deviation = tuple(where(has_position, d, 0.0) for d in deviation)
             left = where(has_position, left, 0.0)
     else:
         deviation, left = _ZERO6, 0.0
-    if has_orientation is True or has_orientation is not False and has_orientation.any():
+    if has_orientation is True or has_orientation is not False and any_(has_orientation):
         new = unwrap_rotvec(log(mul_conjugate(orn, goal_quaternion)), phi)
         orientation_left = orientation_time - time
-        if has_orientation is not True and not has_orientation.all():
+        if has_orientation is not True and not all_(has_orientation):
             new = where3(has_orientation, new, phi)
             orientation_left = where(has_orientation, orientation_left, 0.0)
         phi = new

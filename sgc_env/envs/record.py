@@ -11,25 +11,33 @@ than numpy on tiny arrays), one cast of a whole array for the batch.
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
-from sgc_env.observation import BODY_BLOCK_SIZE, float32_residuals
+from sgc_env.observation import float32_residuals
 
 Vec = Sequence[Any]  # components: floats for one env, arrays for the batch
 
 __all__ = ["body_block", "pack_blocks", "residuals"]
 
 
+def _stacked(values: list[Any]) -> np.ndarray:
+    """The values (arrays, or floats for all) as one array, the first axis theirs: one call
+    when they are arrays of one shape (the batch's), else broadcast first."""
+    try:
+        return np.array(values, dtype=np.float64)
+    except ValueError:  # floats among arrays, or shapes that only broadcast
+        return np.array(np.broadcast_arrays(*values))
+
+
 def residuals(values: list[Any]) -> list[Any]:
     """``x - float32(x)`` of every value (what the float32 observation loses)."""
     if values[0].__class__ is not np.ndarray:
         return float32_residuals(values)
-    exact = np.stack(np.broadcast_arrays(*values))
-    return list(map(operator.sub, exact, exact.astype(np.float32).astype(np.float64)))
+    exact = _stacked(values)
+    return list(exact - exact.astype(np.float32).astype(np.float64))
 
 
 def body_block(
@@ -48,10 +56,7 @@ def body_block(
     ]  # fmt: skip
 
 
-def pack_blocks(entries: list[Any], shape: tuple[int, int]) -> np.ndarray:
-    """The batch's (sub-envs, bodies, block) array of :func:`body_block`'s entries, each an
-    array over (sub-envs, bodies) or a float for all."""
-    out = np.empty((*shape, BODY_BLOCK_SIZE))
-    for k, value in enumerate(entries):
-        out[..., k] = value
-    return out
+def pack_blocks(entries: list[Any], out: np.ndarray) -> None:
+    """Write :func:`body_block`'s entries, each an array over (bodies, sub-envs) or a float
+    for all, into the batch's (sub-envs, bodies, block) array ``out``."""
+    out[...] = _stacked(entries).T

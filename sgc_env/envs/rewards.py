@@ -54,7 +54,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from sgc_env.paper.elementwise import any_, at_least, at_most, sqrt, where
+from sgc_env.paper.elementwise import all_, any_, at_least, at_most, sqrt, where
 
 from .choices import choose
 
@@ -163,7 +163,7 @@ def effort(step: StepScore) -> Any:
 def schedule_error(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
     """``|D - D_sched| / L`` (see the module docstring), uncapped."""
     ahead = left >= 0.0
-    if ahead is True or ahead is not False and ahead.all():  # all_ inline: see elementwise
+    if ahead is True or ahead is not False and all_(ahead):  # one value inline: elementwise
         f = left / c[3]
         rx, ry, rz = c[0] * f, c[1] * f, c[2] * f
     elif not any_(ahead):
@@ -236,10 +236,10 @@ def track_costs(
     total: Any = 0.0
     worst: Any = 0.0
     for has, d, left, course, floor in step.tracks:
-        if has is False or has is not True and not has.any():  # any_ inline: see elementwise
+        if has is False or has is not True and not any_(has):  # one value inline: elementwise
             continue
         value = cost(d, left, course, floor)
-        if has is True or has.all():
+        if has is True or all_(has):
             total, worst = total + value, worst + TRACK_COST_CAP
         else:
             total = where(has, total + value, total)
@@ -251,7 +251,7 @@ def failure_charge(step: StepScore, reward: Any, worst: Any) -> Any:
     """``reward`` less, on a failure, every step left at the worst per-step reward
     (``worst / bodies + 0.01``)."""
     failed = step.failed
-    if failed is False or failed is not True and not failed.any():  # any_ inline
+    if failed is False or failed is not True and not any_(failed):  # one value inline
         return reward
     return where(
         step.failed, reward - (worst / step.n_bodies + EFFORT_WEIGHT) * step.steps_left, reward

@@ -12,7 +12,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from .elementwise import all_, atan2, rint, sqrt, where, where3
+from .elementwise import all_, any_, atan2, rint, sqrt, where, where3
 
 __all__ = [
     "conjugate", "exp", "exp_normalized", "log", "mul", "mul_conjugate", "rotate", "to_matrix",
@@ -82,8 +82,8 @@ def log(q: Sequence[Any]) -> tuple[Any, Any, Any]:
     elementwise on arrays of components (:mod:`sgc_env.paper.elementwise`)."""
     x, y, z, w = q
     flip = w < 0.0
-    if flip is True or flip is not False and flip.any():  # any_ and all_ inline: elementwise
-        if flip is True or flip.all():
+    if flip is True or flip is not False and any_(flip):  # one value tested inline: elementwise
+        if flip is True or all_(flip):
             x, y, z, w = -x, -y, -z, -w
         else:
             x, y, z, w = (
@@ -94,9 +94,9 @@ def log(q: Sequence[Any]) -> tuple[Any, Any, Any]:
             )
     vnorm = sqrt(x * x + y * y + z * z)
     small = vnorm < 1e-12
-    if small is False or small is not True and not small.any():
+    if small is False or small is not True and not any_(small):
         scale = 2.0 * atan2(vnorm, w) / vnorm
-    elif small is True or small.all():
+    elif small is True or all_(small):
         scale = 2.0 / w
     else:
         scale = where(small, 2.0 / w, 2.0 * atan2(vnorm, w) / vnorm)
@@ -117,7 +117,7 @@ def unwrap_rotvec(principal: Sequence[Any], reference: Sequence[Any]) -> tuple[A
     angle = sqrt(px * px + py * py + pz * pz)
     small = angle < 1e-12
     keep = small
-    if small is True or small is not False and small.any():
+    if small is True or small is not False and any_(small):
         rn = sqrt(rx * rx + ry * ry + rz * rz)
         keep = small & (rn < math.pi)
         if all_(keep):
@@ -132,10 +132,10 @@ def unwrap_rotvec(principal: Sequence[Any], reference: Sequence[Any]) -> tuple[A
         ux, uy, uz = px / angle, py / angle, pz / angle
     k = rint((ux * rx + uy * ry + uz * rz - angle) / TWO_PI)
     keep = keep | (k == 0)
-    if keep is True or keep is not False and keep.all():
+    if keep is True or keep is not False and all_(keep):
         return (px, py, pz)
     a = angle + TWO_PI * k
-    if keep is False or not keep.any():
+    if keep is False or not any_(keep):
         return (ux * a, uy * a, uz * a)
     return where3(keep, (px, py, pz), (ux * a, uy * a, uz * a))
 

@@ -200,6 +200,12 @@ def quoted_hint(value: Any) -> str:
 
 
 def vector(value: Any, n: int, path: str) -> tuple[float, ...]:
+    if value.__class__ is tuple and len(value) == n:  # a resolved scene's: finite floats, as is
+        for x in value:
+            if x.__class__ is not float or x - x != 0.0:  # not a float, or NaN or infinite
+                break
+        else:
+            return value
     if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
         raise fail(path, f"expected a list of {n} numbers, got {show(value)}")
     if len(value) != n:

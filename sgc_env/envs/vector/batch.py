@@ -168,9 +168,9 @@ class Batch:
         shape = (len(self._envs), *self.action_shape)
         if a.shape != shape:
             raise ValueError(f"actions have shape {a.shape}, expected {shape} (num_envs, action)")
-        rows = a[indices]
+        rows = a if len(indices) == len(self._envs) else a[indices]  # sorted, distinct indices
         if a.dtype.kind in "fiu" and np.isfinite(rows).all():
-            return np.clip(rows, -1, 1)  # as clip_action, one call for all rows
+            return np.minimum(np.maximum(rows, -1), 1)  # as clip_action, for all rows at once
         out = []  # something is wrong: find the first bad row with the single env's check
         for i in indices:
             try:
@@ -195,7 +195,10 @@ class Batch:
         rewards, terminated, at_limit, events = fast.step(indices, values)
         self._behind = True
         truncated = ~terminated & at_limit
-        self.elapsed[indices] += 1
+        if len(indices) == len(self._envs):  # sorted, distinct indices: every sub-env
+            self.elapsed += 1
+        else:
+            self.elapsed[indices] += 1
         if self.limit is not None:
             truncated |= self.elapsed >= self.limit
         return rewards, terminated, truncated, events
@@ -208,7 +211,7 @@ class Batch:
         for i, v in zip(indices, values, strict=True):
             d, moves = envs[i]._drives(v)
             by_world.setdefault(envs[i].sim.client, []).extend(d)
-            if moves:  # props: where the step leaves them (see BatchTask._place_props)
+            if moves:  # props: where the step leaves them (once, see BatchTask.sync)
                 for uid, spot in moves[-1]:
                     envs[i].sim.move(uid, spot)
         for world in self.worlds:
