@@ -67,7 +67,9 @@ def main() -> None:
     args = parser.parse_args()
     reference = load_sgc_env(args.reference.resolve())
     new = load_sgc_env(HERE)
-    registry = {k: v for k, v in new._REGISTRY.items() if v[0].endswith(":SGCEnv")}
+    # ids both checkouts register: a newer id's kwargs may name arguments the reference lacks
+    registry = {k: v for k, v in new._REGISTRY.items()
+                if v[0].endswith(":SGCEnv") and k in reference._REGISTRY}  # fmt: skip
     print(
         f"{'id':18} {'ref us/step':>12} {'new us/step':>12} {'wall new/ref':>13} "
         f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12}"
