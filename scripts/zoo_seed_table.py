@@ -22,12 +22,16 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from baselines.benchmark.aggregate import iqm, stratified_bootstrap_ci
 from baselines.models.model_files import read_model_data
 from baselines.zoo.manifest import held_out_result
+from sgc_env.scenario.bounded import escaped, load_json, read_text
 
 GOAL_RATE = 0.8
 
@@ -40,23 +44,39 @@ def _model(run: Path) -> Path:
     return models[0]
 
 
+def _monitor_span(path: Path) -> tuple[float, float | None]:
+    """(start, end of the last finished episode or None) of one Monitor file, read through the
+    project's bounded reader: a run folder may come from elsewhere."""
+    what = "Monitor file"
+    lines = read_text(path, what).splitlines()
+    where = f"{what} {escaped(path)}"
+    if not lines or not lines[0].startswith("#"):
+        raise ValueError(f"{where}: no '#{{...}}' header line (not a Monitor file)")
+    header = load_json(lines[0][1:], f"{where}: header")
+    rows = list(csv.DictReader(lines[1:]))
+    try:
+        start = float(header["t_start"])
+        end = start + float(rows[-1]["t"]) if rows else None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(
+            f"{where}: no t_start in the header or no t column ({escaped(exc)})"
+        ) from None
+    if not math.isfinite(start) or (end is not None and not math.isfinite(end)):
+        raise ValueError(f"{where}: t_start and t must be finite numbers")
+    return start, end
+
+
 def training_seconds(run: Path) -> float:
     """The end of the last finished episode over the run's Monitor files (seconds since the
     first Monitor file's start)."""
     files = sorted(run.glob("*.monitor.csv"))
     if not files:
         raise ValueError(f"{run}: no *.monitor.csv files (not an rl-zoo3 run folder)")
-    starts, ends = [], []
-    for path in files:
-        with path.open() as handle:
-            header = json.loads(handle.readline().lstrip("#"))
-            rows = list(csv.DictReader(handle))
-        starts.append(float(header["t_start"]))
-        if rows:
-            ends.append(float(header["t_start"]) + float(rows[-1]["t"]))
+    spans = [_monitor_span(path) for path in files]
+    ends = [end for _, end in spans if end is not None]
     if not ends:
         raise ValueError(f"{run}: no finished episode in the Monitor files")
-    return max(ends) - min(starts)
+    return max(ends) - min(start for start, _ in spans)
 
 
 def seed_row(run: Path, episodes: int, seed: int) -> dict[str, Any]:
@@ -81,7 +101,8 @@ def summary(rows: list[dict[str, Any]]) -> str:
     rates = [rate for env in by_env.values() for rate in env]
     low, high = stratified_bootstrap_ci(list(by_env.values()), iqm)
     met = sum(rate >= GOAL_RATE for rate in rates)
-    return (f"IQM {iqm(rates):.3f} [95 % CI {low:.3f}, {high:.3f}]; {met}/{len(rates)} runs "
+    centre = iqm(np.asarray(rates))
+    return (f"IQM {centre:.3f} [95 % CI {low:.3f}, {high:.3f}]; {met}/{len(rates)} runs "
             f"meet >= {GOAL_RATE:.0%} of held-out goals")  # fmt: skip
 
 
