@@ -7,11 +7,18 @@ until the run's outcome is written; a run another process holds is left to that 
 kernel drops the lock when its process ends, however it ends (SIGKILL included), so a killed
 benchmark never leaves a run locked. Where ``fcntl`` does not exist (Windows) every claim
 succeeds, as before.
+
+The leaderboard is one file for the whole ``--out``: each benchmark rewrites it when it ends,
+from the records it reads then. :func:`report_lock` makes that read and write one step
+(a blocking ``flock`` on ``<out>/.report-claim``), so the benchmark that reports last has
+read every record written before it, and a stale reader never overwrites a fuller board.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 try:
@@ -19,9 +26,10 @@ try:
 except ImportError:  # pragma: no cover - not POSIX
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["CLAIM_FILE", "RunClaims"]
+__all__ = ["CLAIM_FILE", "REPORT_CLAIM_FILE", "RunClaims", "report_lock"]
 
 CLAIM_FILE = ".claim"
+REPORT_CLAIM_FILE = ".report-claim"
 
 
 class RunClaims:
@@ -54,3 +62,17 @@ class RunClaims:
     def release_all(self) -> None:
         for folder in list(self._held):
             self.release(folder)
+
+
+@contextmanager
+def report_lock(root: str | Path) -> Iterator[None]:
+    """Hold ``root``'s report lock (waiting for another benchmark's report to finish)."""
+    path = Path(root)
+    path.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path / REPORT_CLAIM_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing the descriptor drops its lock

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from baselines.benchmark.aggregate import aggregate_runs
-from baselines.benchmark.claims import RunClaims
+from baselines.benchmark.claims import RunClaims, report_lock
 from baselines.benchmark.execute import FAILED_FILE, RESULT_FILE, write_outcome
 from baselines.benchmark.grid import RunSpec, build_grid, load_recipes, recipes_from_algos
 from baselines.benchmark.report import write_report
@@ -118,8 +118,11 @@ def collect_results(
 def report(
     grid: Sequence[RunSpec], root: Path, meta: dict[str, Any], plots: bool
 ) -> tuple[list[Path], int]:
-    """Write the leaderboard of the grid's runs; the files written and how many runs failed."""
-    results, failed = collect_results(grid, root)
-    meta = {**meta, "runs": len(grid), "finished": len(results), "failed": len(failed)}
-    written = write_report(aggregate_runs(results, failed), results, meta, root, plots=plots)
+    """Write the leaderboard of the grid's runs; the files written and how many runs failed.
+    Records are read and the board written under the folder's report lock (another benchmark
+    on the same ``root`` may be reporting)."""
+    with report_lock(root):
+        results, failed = collect_results(grid, root)
+        meta = {**meta, "runs": len(grid), "finished": len(results), "failed": len(failed)}
+        written = write_report(aggregate_runs(results, failed), results, meta, root, plots=plots)
     return written, len(failed)
