@@ -27,13 +27,14 @@ __all__ = [
     "algorithm_class",
     "linear_schedule",
     "load_hyperparams",
+    "training_class",
     "parse_kwargs_string",
 ]
 
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
 _STRING_KWARGS = ("policy_kwargs", "replay_buffer_kwargs")
 _ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std",
-             "reward_shaping"}  # fmt: skip
+             "reward_shaping", "action_rate"}  # fmt: skip
 
 
 @dataclass
@@ -52,6 +53,7 @@ class Hyperparams:
     algo_kwargs: dict[str, Any] = field(default_factory=dict)
     raw: dict[str, Any] = field(default_factory=dict)
     reward_shaping: str = "none"  # training envs only (baselines/agents/shaping.py)
+    action_rate: float = 0.0  # training envs only (baselines/agents/action_rate.py)
 
 
 def _resolve_name(dotted: str, field_name: str) -> Any:
@@ -72,6 +74,10 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
         from baselines.models.schedule_features import ScheduleFeatures
 
         return ScheduleFeatures
+    if short == "LearnerViewBodies":
+        from baselines.models.per_body import LearnerViewBodies
+
+        return LearnerViewBodies
     if short == "HerReplayBuffer":
         from stable_baselines3 import HerReplayBuffer
 
@@ -199,6 +205,20 @@ def algorithm_class(algo: str):
     return classes[algo]
 
 
+SMOOTHNESS_KEYS = ("temporal", "spatial", "spatial_std")
+"""PPO fields that train with :class:`baselines.agents.smooth_ppo.SmoothPPO` (CAPS terms)."""
+
+
+def training_class(hp: Hyperparams) -> type:
+    """The class that trains ``hp``: :func:`algorithm_class`, or ``SmoothPPO`` for a PPO entry
+    that sets CAPS smoothness fields (a model it saves loads as a plain PPO)."""
+    if hp.algo == "ppo" and any(key in hp.algo_kwargs for key in SMOOTHNESS_KEYS):
+        from baselines.agents.smooth_ppo import SmoothPPO
+
+        return SmoothPPO
+    return algorithm_class(hp.algo)
+
+
 def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None) -> Hyperparams:
     """Read ``<directory>/<algo>.yml`` (default: the packaged file) and resolve ``env_id``."""
     algo_cls = algorithm_class(algo)
@@ -219,7 +239,12 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         if key not in entry:
             raise ValueError(f"{path}: {env_id}: missing field {key!r}")
     kwargs: dict[str, Any] = {}
-    parameters = inspect.signature(algo_cls.__init__).parameters
+    parameters = dict(inspect.signature(algo_cls.__init__).parameters)
+    if algo == "ppo":  # the CAPS fields train with SmoothPPO (training_class)
+        from baselines.agents.smooth_ppo import SmoothPPO
+
+        smooth = inspect.signature(SmoothPPO.__init__, eval_str=True).parameters
+        parameters.update({key: smooth[key] for key in SMOOTHNESS_KEYS})
     allowed = set(parameters) - {"self", "policy", "env"}
     for key, value in entry.items():
         if key in _ZOO_KEYS:
@@ -260,9 +285,13 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         n_timesteps = int(float(entry["n_timesteps"]))
         n_envs = int(entry.get("n_envs", 1))
         noise_std = float(entry.get("noise_std", 0.1))
+        action_rate = float(entry.get("action_rate", 0.0))
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs and noise_std must be finite "
-                         "numbers") from None  # fmt: skip
+        raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs, noise_std and action_rate "
+                         "must be finite numbers") from None  # fmt: skip
+    if not (math.isfinite(action_rate) and action_rate >= 0):
+        raise ValueError(f"{path}: {env_id}: action_rate must be a finite weight >= 0, "
+                         f"got {entry.get('action_rate')!r}")  # fmt: skip
     shaping = entry.get("reward_shaping", "none")
     if shaping not in ("none", "smooth", "smooth_alive"):
         raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none', 'smooth' or "
@@ -286,4 +315,5 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         algo_kwargs=kwargs,
         raw=dict(entry),
         reward_shaping=shaping,
+        action_rate=action_rate,
     )

@@ -18,7 +18,12 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from baselines.agents.hyperparams import ALGORITHMS, Hyperparams, algorithm_class
+from baselines.agents.hyperparams import (
+    ALGORITHMS,
+    Hyperparams,
+    algorithm_class,
+    training_class,
+)
 from baselines.agents.pushes import Pushes
 from baselines.common.env_kwargs import check_env_kwargs
 from sgc_env.defaults import EVAL_SEED
@@ -173,6 +178,10 @@ def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
         from baselines.agents.shaping import SmoothScheduleCost
 
         env = SmoothScheduleCost(env, alive=hp.reward_shaping == "smooth_alive")
+    if hp.action_rate:
+        from baselines.agents.action_rate import ActionRatePenalty
+
+        env = ActionRatePenalty(env, hp.action_rate)
     if hp.normalize:
         # rl-zoo3's rule: the reward's running return uses the algorithm's gamma unless the
         # file's normalize gives its own
@@ -193,7 +202,7 @@ def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
         out.mkdir(parents=True, exist_ok=True)
         kwargs["tensorboard_log"] = str(out / "tb")
     try:
-        model = algorithm_class(cfg.algo)(
+        model = training_class(hp)(
             hp.policy, env, seed=cfg.seed, device=cfg.device, verbose=cfg.verbose, **kwargs
         )
     except (TypeError, ValueError, AssertionError) as exc:  # values SB3 itself refuses

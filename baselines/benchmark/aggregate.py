@@ -36,7 +36,8 @@ N_RESAMPLES = 2000
 METRICS: tuple[str, ...] = (
     "success_rate", "position_error_mean", "position_error_max", "orientation_error_mean",
     "position_closest_offset_abs_max", "sparc_track_mean", "velocity_jump_max",
-    "force_sq_integral_mean", "terminated", "return_mean",
+    "force_sq_integral_mean", "terminated", "return_mean", "acceleration_kink_max",
+    "angular_acceleration_kink_max",
 )  # fmt: skip
 
 Statistic = Callable[[np.ndarray], np.ndarray]

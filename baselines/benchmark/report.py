@@ -38,6 +38,8 @@ COLUMNS: tuple[tuple[str, str, str, str], ...] = (
     ("final", "position_error_mean", "pos err mean (m), final", ".3f"),
     ("final", "position_closest_offset_abs_max", "closest offset max (s), final", ".3f"),
     ("final", "sparc_track_mean", "SPARC track, final", ".2f"),
+    ("final", "acceleration_kink_max", "kink (m/s²), final", ".1f"),
+    ("final", "angular_acceleration_kink_max", "ang kink (rad/s²), final", ".1f"),
 )
 
 

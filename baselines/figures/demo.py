@@ -35,11 +35,14 @@ from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
 
 __all__ = [
-    "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_policy",
-    "gif_durations", "pierce_times", "run_demo",
+    "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_env_id",
+    "demo_policy", "gif_durations", "pierce_times", "run_demo",
 ]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v1"
+"""The paper's scene with the planner's view: the expert and the hand-written controllers fly it."""
+LEARNER_ENV_ID = "SGCThreeRods-v2"
+"""The same scene with the learner's view: models trained on the newest ids fly it."""
 PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
 """Moments the plates show: launch, piercing, flight, somersault, the hits, all three in."""
 ROD_DRAW_RADIUS = 0.075
@@ -193,15 +196,31 @@ def demo_policy(options: DemoOptions, env: Any) -> Any:
     return make_policy(options.policy, env, seed=0, trust_model=options.trust_model)
 
 
-def check_policy(options: DemoOptions) -> None:
-    """Raise :func:`demo_policy`'s ValueError now, before any output or progress bar."""
+def demo_env_id(options: DemoOptions) -> str:
+    """The version of the paper's scene the policy flies: :data:`ENV_ID`, or
+    :data:`LEARNER_ENV_ID` for a model file whose observation is the learner's view; raises
+    :func:`demo_policy`'s ValueError (for the planner's version) when neither fits."""
     import gymnasium as gym
 
-    env = gym.make(ENV_ID)
-    try:
-        demo_policy(options, env)
-    finally:
-        env.close()
+    from baselines.models.model_files import ModelFileError
+
+    first: ModelFileError | None = None
+    for env_id in (ENV_ID, LEARNER_ENV_ID):
+        env = gym.make(env_id)
+        try:
+            demo_policy(options, env)
+            return env_id
+        except ModelFileError as exc:  # a model that does not fit; the other view may
+            first = first or exc
+        finally:
+            env.close()
+    assert first is not None
+    raise first
+
+
+def check_policy(options: DemoOptions) -> None:
+    """Raise :func:`demo_policy`'s ValueError now, before any output or progress bar."""
+    demo_env_id(options)
 
 
 def run_demo(
@@ -220,7 +239,8 @@ def run_demo(
     )
 
     started = cpu_seconds()
-    env = gym.make(ENV_ID)
+    env_id = demo_env_id(options)
+    env = gym.make(env_id)
     try:
         policy = demo_policy(options, env)
     except BaseException:
@@ -248,7 +268,7 @@ def run_demo(
         drawn = None if progress is None else (lambda step: progress(base.max_steps + step, total))
         frame_every = round(base.control_frequency / VIDEO_FPS)
         result.frames, result.frame_times = _draw(scenario, ticks, options, frame_every, drawn)
-    rows = goal_rows(record, ENV_ID, result.label)
+    rows = goal_rows(record, env_id, result.label)
     result.summary = summarize([record], rows)
     result.files["goals.csv"] = write_goals_csv(rows, options.out / "goals.csv")
     result.files["summary.json"] = write_summary_json(result.summary, options.out / "summary.json")

@@ -86,7 +86,7 @@ def allowed_classes() -> dict[str, type]:
     from stable_baselines3.td3 import policies as td3
 
     from baselines.models.features import ACTIVATIONS, StandardizeObservation
-    from baselines.models.per_body import PerBodyPolicy
+    from baselines.models.per_body import LearnerViewBodies, PerBodyPolicy
     from baselines.models.schedule_features import ScheduleFeatures
 
     classes: list[type] = [
@@ -95,7 +95,7 @@ def allowed_classes() -> dict[str, type]:
         sac.MultiInputPolicy,
         td3.TD3Policy, td3.CnnPolicy, td3.MultiInputPolicy,
         torch_layers.FlattenExtractor, torch_layers.NatureCNN, torch_layers.CombinedExtractor,
-        StandardizeObservation, ScheduleFeatures,
+        StandardizeObservation, ScheduleFeatures, LearnerViewBodies,
         *(getattr(th.nn, name) for name in ACTIVATIONS),
         th.optim.Adam, th.optim.AdamW, th.optim.RMSprop, th.optim.SGD,
         buffers.RolloutBuffer, buffers.DictRolloutBuffer, buffers.ReplayBuffer,

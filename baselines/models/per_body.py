@@ -2,11 +2,14 @@
 
 The bodies of an SGC scene never interact, and every body's goals enter the observation in
 the same per-body block, so the three-rod problem is three copies of one 6-D problem.
-:class:`PerBodyPolicy` maps each body's slice of the learner features
-(:class:`~baselines.models.schedule_features.ScheduleFeatures`, 16 per track) through the same
-MLP to that body's 6-D action and concatenates the actions; the critic averages per-body values
-(the env's reward is a mean over bodies). Three bodies give three samples of the shared net
-per env step, and the same weights run on any number of bodies.
+:class:`PerBodyPolicy` maps each body's slice of the features through the same MLP to that
+body's 6-D action and concatenates the actions. The features are the env's own learner view
+(:class:`LearnerViewBodies`: the body's two tracks of the view, 23 entries each, and the
+episode's time fraction) or, on a planner-view id, the features computed inside the policy
+(:class:`~baselines.models.schedule_features.ScheduleFeatures`, 16 per track); the
+critic averages per-body values (the env's reward is a mean over bodies). Three bodies give
+three samples of the shared net per env step, and the same weights run on any number of
+bodies.
 
 **Actions in acceleration units.** The net's output is a desired acceleration in units of
 ``REFERENCE_ACCELERATION`` (m/s^2 for the force, rad/s^2 for the torque; the action scale of
@@ -33,16 +36,19 @@ import numpy as np
 import torch as th
 from stable_baselines3.common.distributions import DiagGaussianDistribution, Distribution
 from stable_baselines3.common.policies import ActorCriticPolicy
+from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
 from baselines.common.env_model import EnvModel
 from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
+from sgc_env.envs.learner_view import LEARNER_BODY_SIZE, LEARNER_TRACK_SIZE, learner_size
 from sgc_env.scenario.bounded import escaped
 
 __all__ = [
     "BODY_ACTIONS",
     "BODY_FEATURES",
+    "LearnerViewBodies",
     "REFERENCE_ACCELERATION",
     "PerBodyPolicy",
     "body_gains",
@@ -52,8 +58,10 @@ BODY_ACTIONS = 6
 _SGC_ID = re.compile(r"SGC[A-Za-z0-9]{1,60}-v\d{1,4}")
 """The ids ``gains_env`` may name: this package's (registered or renamed), no other env's."""
 BODY_FEATURES = 2 * TRACK_FEATURES
-"""What the shared net reads of each body: the two tracks' features (the gravity column of
-:class:`ScheduleFeatures` is dropped: the hover is in the action map)."""
+"""What the shared net reads of each body from :class:`ScheduleFeatures`: the two tracks'
+features (its gravity column is dropped: the hover is in the action map)."""
+LEARNER_BODY_FEATURES = 2 * LEARNER_TRACK_SIZE + 1
+"""What the shared net reads of each body from :class:`LearnerViewBodies`."""
 REFERENCE_ACCELERATION = 100.0
 """m/s^2 and rad/s^2 per unit of the net's output (SGCRod-v0's own action scale)."""
 
@@ -86,6 +94,38 @@ def body_gains(env: Any) -> tuple[np.ndarray, np.ndarray]:
     return gain, offset
 
 
+class LearnerViewBodies(BaseFeaturesExtractor):
+    """The env's learner view regrouped per body: each body's two tracks (23 entries each) and
+    the episode's time fraction, ``(batch, n * 47)``. The view's hovering action is dropped:
+    the policy's action map adds the hover (:func:`body_gains`), so the net's output means the
+    same acceleration on every scene."""
+
+    def __init__(self, observation_space: gym.spaces.Space) -> None:
+        shape = getattr(observation_space, "shape", None)
+        size = int(shape[0]) if isinstance(observation_space, gym.spaces.Box) and shape else 0
+        n_bodies = (size - 1) // LEARNER_BODY_SIZE
+        if len(shape or ()) != 1 or n_bodies < 1 or learner_size(n_bodies) != size:
+            raise ValueError(
+                f"LearnerViewBodies needs the learner view (n * {LEARNER_BODY_SIZE} + 1 "
+                f"entries), got {observation_space}"
+            )
+        super().__init__(observation_space, n_bodies * LEARNER_BODY_FEATURES)
+        self.n_bodies = n_bodies
+
+    def forward(self, observations: th.Tensor) -> th.Tensor:
+        obs = observations.float()
+        bodies = obs[:, :-1].reshape(obs.shape[0], self.n_bodies, LEARNER_BODY_SIZE)
+        clock = obs[:, -1:].unsqueeze(1).expand(-1, self.n_bodies, -1)
+        return th.cat([bodies[..., : 2 * LEARNER_TRACK_SIZE], clock], dim=-1).flatten(1)
+
+
+_BODY_INPUTS: dict[type, tuple[int, int]] = {
+    ScheduleFeatures: (BODY_FEATURES + 1, BODY_FEATURES),
+    LearnerViewBodies: (LEARNER_BODY_FEATURES, LEARNER_BODY_FEATURES),
+}
+"""Per features extractor: the features per body it hands out, and how many the net reads."""
+
+
 def _mlp(sizes: list[int], activation: type[nn.Module]) -> nn.Sequential:
     layers: list[nn.Module] = []
     for a, b in zip(sizes[:-1], sizes[1:], strict=True):
@@ -94,7 +134,8 @@ def _mlp(sizes: list[int], activation: type[nn.Module]) -> nn.Sequential:
 
 
 class PerBodyExtractor(nn.Module):
-    """The shared per-body MLPs: ``(batch, n * 33)`` features to ``(batch, n * latent)``;
+    """The shared per-body MLPs: ``(batch, n * stride)`` features, of which the first ``width``
+    of each body's are read, to ``(batch, n * latent)``;
     with ``skip`` the actor's latent also carries the body's features (why: a fixed linear law
     on them meets every three-rod goal, docs/agents.md, so the head can start from one)."""
 
@@ -105,19 +146,21 @@ class PerBodyExtractor(nn.Module):
         vf: list[int],
         activation: type[nn.Module],
         skip: bool = False,
+        width: int = BODY_FEATURES,
     ) -> None:
         super().__init__()
         self.n_bodies = n_bodies
+        self.width = width
         self.skip = skip and bool(pi)
-        self.policy_net = _mlp([BODY_FEATURES, *pi], activation)
-        self.value_net = _mlp([BODY_FEATURES, *vf], activation)
-        self.latent_pi = (pi[-1] + BODY_FEATURES * self.skip) if pi else BODY_FEATURES
-        self.latent_vf = vf[-1] if vf else BODY_FEATURES
+        self.policy_net = _mlp([width, *pi], activation)
+        self.value_net = _mlp([width, *vf], activation)
+        self.latent_pi = (pi[-1] + width * self.skip) if pi else width
+        self.latent_vf = vf[-1] if vf else width
         self.latent_dim_pi = n_bodies * self.latent_pi
         self.latent_dim_vf = n_bodies * self.latent_vf
 
     def _bodies(self, features: th.Tensor) -> th.Tensor:
-        return features.reshape(features.shape[0], self.n_bodies, -1)[..., :BODY_FEATURES]
+        return features.reshape(features.shape[0], self.n_bodies, -1)[..., : self.width]
 
     def forward(self, features: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
         return self.forward_actor(features), self.forward_critic(features)
@@ -157,7 +200,8 @@ class PerBodyPolicy(ActorCriticPolicy):
     ``gains_env``: the env id whose bodies set the action gains at construction (None: gain 1,
     no hover, ``SGCRod-v0``'s scale without gravity); ``bind_env`` resets them for another env.
     ``skip``: the action head reads the body's features beside the last hidden layer.
-    The features extractor must be :class:`ScheduleFeatures` (the default here). The action
+    The features extractor is :class:`ScheduleFeatures` (the default: planner-view ids) or
+    :class:`LearnerViewBodies` (the learner view of the newest ids). The action
     noise's log std is shared per action component across bodies (6 parameters) and, like the
     mean, in acceleration units (``log_std_init=-3``: 5 m/s^2 and 5 rad/s^2 on every scene).
     """
@@ -173,8 +217,9 @@ class PerBodyPolicy(ActorCriticPolicy):
         **kwargs: Any,
     ) -> None:
         kwargs.setdefault("features_extractor_class", ScheduleFeatures)
-        if kwargs["features_extractor_class"] is not ScheduleFeatures:
-            raise ValueError("PerBodyPolicy: features_extractor_class must be ScheduleFeatures")
+        if kwargs["features_extractor_class"] not in _BODY_INPUTS:
+            raise ValueError("PerBodyPolicy: features_extractor_class must be ScheduleFeatures "
+                             "or LearnerViewBodies")  # fmt: skip
         if kwargs.get("use_sde"):
             raise ValueError("PerBodyPolicy: use_sde is not supported")
         self.gains_env = gains_env
@@ -214,15 +259,17 @@ class PerBodyPolicy(ActorCriticPolicy):
         return data
 
     def _build_mlp_extractor(self) -> None:
-        if self.features_dim != self.n_bodies * (BODY_FEATURES + 1):
+        extractor = type(self.features_extractor)
+        stride, width = _BODY_INPUTS[extractor]
+        if self.features_dim != self.n_bodies * stride:
             raise ValueError(
                 f"PerBodyPolicy: {self.features_dim} features for {self.n_bodies} bodies; "
-                f"expected ScheduleFeatures' {BODY_FEATURES + 1} per body"
+                f"expected {extractor.__name__}'s {stride} per body"
             )
         arch = self.net_arch
         pi, vf = (arch["pi"], arch["vf"]) if isinstance(arch, dict) else (arch, arch)
         self.mlp_extractor = PerBodyExtractor(  # type: ignore[assignment]
-            self.n_bodies, list(pi), list(vf), self.activation_fn, self.skip
+            self.n_bodies, list(pi), list(vf), self.activation_fn, self.skip, width
         )
 
     def _build(self, lr_schedule: Any) -> None:
