@@ -16,7 +16,7 @@ SGC=${SGC:-.venv/bin/sgc}
 # keep in step with the budget recipes of benchmarks/recipes.yml (tests/baselines/agents/test_budget.py checks)
 ROWS=ppo-rod300-300s,sac-300s,td3-300s,ppo-raw-300s,bc-dagger-300s
 ROWS=$ROWS,ppo-point500k-120s,ppo-raw-120s,sac-120s,td3-120s,her-time-120s,bc-dagger-120s
-ROWS=$ROWS,zoo-ppo-300s,zoo-ppo-120s
+ROWS=$ROWS,zoo-ppo-300s,zoo-ppo-120s,zoo-sac-120s,zoo-td3-120s
 if [[ " $* " != *" --report-only "* ]]; then
     for env in SGCPoint-v0 SGCRod-v0; do  # the BC+DAgger rows' demonstrations (not timed)
         demos=runs/benchmark-demos/${env}_100.npz
