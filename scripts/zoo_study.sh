@@ -6,7 +6,8 @@
 # n_steps 4096 is 262k steps). Tuning seed 9001: not a leaderboard training seed (0-9) and its
 # evaluations (rl-zoo3 evaluates on its own env seeds) are not the held-out seeds 20000+.
 # Each study's trials go to a journal file, so a rerun resumes it; reports (CSV) land in
-# $OUT/<algo>/report_*.csv and `scripts/zoo_study_table.py $OUT` tabulates them.
+# $OUT/<algo>/report_*.csv, each trial's best model (by its evaluations) to
+# $OUT/<algo>/trials/trial_<n>/best_model.zip; `scripts/zoo_study_table.py $OUT` tabulates them.
 #   scripts/zoo_study.sh                 # ppo sac td3, 10 trials x 50k steps each
 #   ALGOS="sac" TRIALS=4 scripts/zoo_study.sh
 set -euo pipefail
@@ -23,5 +24,6 @@ for algo in $ALGOS; do
         -optimize --n-trials "$TRIALS" --n-startup-trials 4 --n-timesteps "$STEPS" \
         --n-evaluations 2 --eval-episodes 5 --sampler tpe --pruner median --seed 9001 \
         --num-threads 1 --no-optim-plots --storage "$OUT/$algo/study.log" \
+        --optimization-log-path "$OUT/$algo/trials" \
         --study-name "$algo-$ENV_ID" -f "$OUT"
 done

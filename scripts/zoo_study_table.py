@@ -4,9 +4,12 @@
 same trials, steps per trial, pruner and evaluation; rl-zoo3 writes each study's trials to
 ``<out>/<algo>/report_<env>_<n>-trials-<steps>-<sampler>-<pruner>_<time>.csv`` (the
 objective is its evaluation callback's mean episode reward, the env's own reward, on its own
-evaluation seeds). This reads the newest report of every family and prints a Markdown table::
+evaluation seeds). This reads the newest report of every family and prints a Markdown table;
+with ``--episodes N`` it also scores the best trial's model
+(``<out>/<algo>/trials/trial_<n>/best_model.zip``) with the harness on held-out reset seeds
+(``--seed`` onwards, which no trial saw), because the reward saturates before the goals do::
 
-    python scripts/zoo_study.sh && python scripts/zoo_study_table.py runs/zoo-study [--json s.json]
+    scripts/zoo_study.sh && python scripts/zoo_study_table.py runs/zoo-study --episodes 50
 
 Read as text through the project's bounded reader (a report may come from elsewhere); the
 ``.pkl`` beside each report is never opened.
@@ -24,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from baselines.zoo.manifest import held_out_result
 from sgc_env.scenario.bounded import escaped, read_text
 
 _REPORT = re.compile(r"report_(?P<env>[^_]+)_(?P<trials>\d+)-trials-(?P<steps>\d+)"
@@ -94,16 +98,32 @@ def study_row(folder: Path) -> dict[str, Any]:
     }  # fmt: skip
 
 
+def score_best(row: dict[str, Any], folder: Path, episodes: int, seed: int) -> None:
+    """Add the held-out goals of the best trial's model to ``row``."""
+    model = folder / "trials" / f"trial_{row['best_trial']}" / "best_model.zip"
+    if not model.is_file():
+        raise ValueError(f"{escaped(model)}: no model of the best trial (run the study with "
+                         "--optimization-log-path, as scripts/zoo_study.sh does)")  # fmt: skip
+    result = held_out_result(model, row["env"], episodes, seed)
+    row["held_out"] = {"goals_met": result["goals_met"], "n_goals": result["n_goals"],
+                       "episodes": episodes, "seed": seed}  # fmt: skip
+
+
 def markdown(rows: list[dict[str, Any]]) -> str:
+    scored = all("held_out" in r for r in rows)
     lines = ["| family | env | trials (complete / pruned / failed) | steps per trial | best "
-             "reward | median reward | best trial's settings | study seconds |",
-             "|---|---|---|---|---|---|---|---|"]  # fmt: skip
+             "reward | median reward | best trial's settings | study seconds |"
+             + (" best trial's held-out goals |" if scored else ""),
+             "|---|---|---|---|---|---|---|---|" + ("---|" if scored else "")]  # fmt: skip
     for r in rows:
         settings = ", ".join(f"{k} {v}" for k, v in r["settings"].items())
         counts = f"{r['trials']} ({r['complete']} / {r['pruned']} / {r['failed']})"
         lines.append(f"| {r['algo'].upper()} | {r['env']} | {counts} | "
                      f"{r['steps_per_trial']:,} | {r['best']:.1f} | {r['median']:.1f} | "
                      f"{settings} | {r['seconds']} |")  # fmt: skip
+        if scored:
+            held = r["held_out"]
+            lines[-1] += f" {held['goals_met']}/{held['n_goals']} |"
     return "\n".join(lines)
 
 
@@ -111,11 +131,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("out", type=Path, help="the study's folder (scripts/zoo_study.sh's OUT)")
     parser.add_argument("--json", type=Path, help="also write the rows as JSON")
+    parser.add_argument("--episodes", type=int, default=0,
+                        help="score each best trial's model on this many held-out episodes")
+    parser.add_argument("--seed", type=int, default=20_000, help="first held-out reset seed")
     args = parser.parse_args()
-    folders = sorted(p for p in args.out.iterdir() if p.is_dir())
-    rows = [study_row(folder) for folder in folders if any(folder.glob("report_*.csv"))]
-    if not rows:
+    folders = sorted(p for p in args.out.iterdir() if p.is_dir() and any(p.glob("report_*.csv")))
+    if not folders:
         raise SystemExit(f"{escaped(args.out)}: no family folder with a report_*.csv")
+    rows = []
+    for folder in folders:
+        rows.append(study_row(folder))
+        if args.episodes > 0:
+            score_best(rows[-1], folder, args.episodes, args.seed)
     print(markdown(rows))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=2))

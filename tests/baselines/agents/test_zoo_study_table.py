@@ -58,3 +58,11 @@ def test_a_bad_report_names_the_file_and_the_trial(tmp_path: Path, rows: str, me
 def test_a_folder_without_reports_says_how_to_make_them(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="no rl-zoo3 report_.*scripts/zoo_study.sh"):
         _script().study_row(tmp_path)
+
+
+def test_scoring_needs_the_best_trials_model(tmp_path: Path) -> None:
+    _report(tmp_path / "ppo", "0,0,5,a,b,0 days 00:00:01,0.1,0.5,8,COMPLETE\n")
+    script = _script()
+    row = script.study_row(tmp_path / "ppo")
+    with pytest.raises(ValueError, match=r"trial_0/best_model.zip: no model of the best trial"):
+        script.score_best(row, tmp_path / "ppo", 1, 20000)
