@@ -15,7 +15,8 @@ pytest.importorskip("stable_baselines3")
 import torch as th  # noqa: E402
 from stable_baselines3 import PPO  # noqa: E402
 
-from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
+from baselines.agents.hyperparams import load_hyperparams, training_class  # noqa: E402
+from baselines.agents.smooth_ppo import SmoothPPO  # noqa: E402
 from baselines.evaluation.harness import evaluate  # noqa: E402
 from baselines.models.model_files import load_sb3_model  # noqa: E402
 from baselines.models.per_body import (  # noqa: E402
@@ -104,7 +105,8 @@ def test_the_recipes_name_the_view_and_the_newest_random_id(recipe: str) -> None
     assert hp.policy is PerBodyPolicy and kwargs["gains_env"] == RANDOM_ID
     assert kwargs["features_extractor_class"] is LearnerViewBodies
     assert hp.reward_shaping == "none"
-    assert (hp.action_rate > 0) == (recipe == "ppo_threerod_smooth")
+    smooth = recipe == "ppo_threerod_smooth"
+    assert (training_class(hp) is SmoothPPO) == smooth and hp.action_rate == 0
 
 
 def test_the_demo_flies_each_model_on_the_version_of_the_scene_it_observes(tmp_path: Path) -> None:
