@@ -43,7 +43,7 @@ RESULTS = {
     ),
     "demo": Result("sgc demo --out runs/demo", "runs/demo/rods.json"),
     "demo-learned": Result(
-        "sgc demo --policy shipped:ppo_perbody_SGCThreeRodsRandom-v2 --out runs/demo-learned",
+        "sgc demo --policy shipped:ppo_caps_SGCThreeRodsRandom-v3 --out runs/demo-learned",
         "runs/demo-learned/rods.json",
     ),
     "smoothness": Result(
