@@ -35,7 +35,7 @@ def test_manifest_entries_are_consistent() -> None:
     import sgc_env
 
     for entry in ENTRIES:
-        assert entry["env_id"] in sgc_env.ENV_IDS
+        assert entry["env_id"] in sgc_env.ENV_IDS + sgc_env.LEARNER_IDS
         assert entry["algo"] in ("ppo", "sac", "td3", "her")
         assert (
             entry["command"].startswith("sgc train")
