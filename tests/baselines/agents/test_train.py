@@ -405,6 +405,7 @@ SHIPPED_SCORES = {
     "ppo_schedule_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
     "ppo_schedule_SGCRod-v0.zip": ("SGCRod-v0", 0.9),
     "ppo_perbody_SGCThreeRodsRandom-v2.zip": ("SGCThreeRodsRandom-v2", 0.85),
+    "ppo_caps_SGCThreeRodsRandom-v3.zip": ("SGCThreeRodsRandom-v3", 0.85),
     "ppo_rod300_SGCRod-v0.zip": ("SGCRod-v0", 0.8),
     "ppo_point500k_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
 }

@@ -262,6 +262,7 @@ def test_safe_and_trusted_loading_predict_alike(clean: Path) -> None:
 def test_shipped_models_hold_no_pickle_beside_them() -> None:
     assert not list(SHIPPED.glob("*.pkl"))
     assert sorted(p.name for p in SHIPPED.glob("*.vecnormalize.json")) == [
+        "ppo_caps_SGCThreeRodsRandom-v3.vecnormalize.json",
         "ppo_point500k_SGCPoint-v0.vecnormalize.json", "ppo_rod300_SGCRod-v0.vecnormalize.json",
         "ppo_schedule_SGCPoint-v0.vecnormalize.json", "ppo_schedule_SGCRod-v0.vecnormalize.json",
     ]  # fmt: skip
@@ -280,16 +281,18 @@ def test_demo_refuses_a_model_of_other_spaces_before_unpickling(
 
 
 def test_shipped_models_name_classes_by_their_old_paths_and_those_are_allowed() -> None:
-    """The shipped zips were saved before the model classes moved to ``baselines.models``:
-    the classes they name by the old module paths are on the allow-list, as today's classes."""
+    """Most shipped zips were saved before the model classes moved to ``baselines.models``:
+    the classes they name by the old module paths are on the allow-list, as today's classes,
+    and every class a shipped zip names is allowed."""
     from baselines.models.model_files import MOVED_MODULES, allowed_classes, read_model_data
 
     named = set()
     for model in sorted(SHIPPED.glob("*.zip")):
         data, _ = read_model_data(model.read_bytes(), str(model))
         named |= set(re.findall(r"<class '(baselines\.[\w.]+)'>", json.dumps(data)))
-    assert named and all(name.rpartition(".")[0] in MOVED_MODULES for name in named), named
+    old = {name for name in named if name.rpartition(".")[0] in MOVED_MODULES}
     allowed = allowed_classes()
-    for name in named:
+    assert old and all(name in allowed for name in named), named
+    for name in old:
         module, _, qualname = name.rpartition(".")
         assert allowed[name] is allowed[f"{MOVED_MODULES[module]}.{qualname}"]
