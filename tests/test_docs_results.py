@@ -56,7 +56,7 @@ def test_every_marker_pair_in_the_docs_is_a_known_table() -> None:
     for doc in paste.documents():
         for name in re.findall(r"<!-- ([\w-]+):begin -->", doc.read_text()):
             known = name in names or name in ("leaderboard", "budget-leaderboard",
-                                              "threerod-leaderboard")
+                                              "threerod-leaderboard", "stock-leaderboard")
             assert known, f"{doc.name}: block {name!r} has no command in paste_results.py"
 
 
