@@ -19,12 +19,13 @@ to the training envs only (evaluation scores goals and kinks, not rewards) and s
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
+
+from baselines.common.value_types import check_weight
 
 __all__ = ["ActionRatePenalty"]
 
@@ -34,15 +35,11 @@ class ActionRatePenalty(VecEnvWrapper):
     docstring); the first step of every episode is not charged."""
 
     def __init__(self, venv: VecEnv, weight: float) -> None:
-        if isinstance(weight, bool) or not isinstance(weight, (int, float)) or not (
-            math.isfinite(weight) and weight >= 0
-        ):
-            raise ValueError(f"action_rate: expected a finite weight >= 0, got {weight!r}")
+        self.weight = check_weight(weight, "action_rate")
         space = venv.action_space
         if not isinstance(space, spaces.Box):
             raise ValueError(f"action_rate: needs a Box action space, got {space}")
         super().__init__(venv)
-        self.weight = float(weight)
         self._low, self._high = space.low, space.high
         shape = (venv.num_envs, int(np.prod(venv.action_space.shape or (1,))))
         self._previous = np.zeros(shape, dtype=np.float64)

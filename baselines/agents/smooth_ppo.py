@@ -21,7 +21,6 @@ for step.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Generator
 from typing import Any
 
@@ -31,15 +30,9 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.buffers import RolloutBuffer
 from stable_baselines3.common.type_aliases import RolloutBufferSamples
 
+from baselines.common.value_types import check_weight
+
 __all__ = ["SmoothPPO", "SuccessorRolloutBuffer"]
-
-
-def _weight(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
-        math.isfinite(value) and value >= 0
-    ):
-        raise ValueError(f"{name}: expected a finite number >= 0, got {value!r}")
-    return float(value)
 
 
 class SuccessorRolloutBuffer(RolloutBuffer):
@@ -94,9 +87,9 @@ class SmoothPPO(PPO):
         spatial_std: float = 0.05,
         **kwargs: Any,
     ) -> None:
-        self.temporal = _weight("temporal", temporal)
-        self.spatial = _weight("spatial", spatial)
-        self.spatial_std = _weight("spatial_std", spatial_std)
+        self.temporal = check_weight(temporal, "temporal")
+        self.spatial = check_weight(spatial, "spatial")
+        self.spatial_std = check_weight(spatial_std, "spatial_std")
         kwargs.setdefault("rollout_buffer_class", SuccessorRolloutBuffer)
         super().__init__(*args, **kwargs)
 

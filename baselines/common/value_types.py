@@ -16,7 +16,7 @@ import typing
 from pathlib import Path
 from typing import Any
 
-__all__ = ["describe", "matches"]
+__all__ = ["check_weight", "describe", "matches"]
 
 _NAMES = {bool: "true/false", int: "an integer", float: "a finite number", str: "a string",
           type(None): "null", dict: "a mapping", Path: "a path"}  # fmt: skip
@@ -56,3 +56,13 @@ def describe(annotation: Any) -> str:
         return "a schedule"
     base = typing.get_origin(annotation) or annotation
     return _NAMES.get(base, getattr(base, "__name__", str(base)))
+
+
+def check_weight(value: Any, name: str) -> float:
+    """``value`` as a float when it is a finite number >= 0 (a loss or reward weight; ``True``
+    is not a number here); otherwise a ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
+        math.isfinite(value) and value >= 0
+    ):
+        raise ValueError(f"{name}: expected a finite weight >= 0, got {value!r}")
+    return float(value)
