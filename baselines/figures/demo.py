@@ -36,7 +36,7 @@ from sgc_env.simulator import pybullet
 
 __all__ = [
     "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_env_id",
-    "demo_policy", "gif_durations", "pierce_times", "run_demo",
+    "demo_policy", "gif_durations", "open_demo", "pierce_times", "run_demo",
 ]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v1"
@@ -196,10 +196,11 @@ def demo_policy(options: DemoOptions, env: Any) -> Any:
     return make_policy(options.policy, env, seed=0, trust_model=options.trust_model)
 
 
-def demo_env_id(options: DemoOptions) -> str:
-    """The version of the paper's scene the policy flies: :data:`ENV_ID`, or
-    :data:`LEARNER_ENV_ID` for a model file whose observation is the learner's view; raises
-    :func:`demo_policy`'s ValueError (for the planner's version) when neither fits."""
+def open_demo(options: DemoOptions) -> tuple[str, Any, Any]:
+    """The version of the paper's scene the policy flies (:data:`ENV_ID`, or
+    :data:`LEARNER_ENV_ID` for a model file whose observation is the learner's view), that env
+    (open: the caller closes it) and the policy on it; raises :func:`demo_policy`'s ValueError
+    (for the planner's version) when neither fits."""
     import gymnasium as gym
 
     from baselines.models.model_files import ModelFileError
@@ -208,14 +209,22 @@ def demo_env_id(options: DemoOptions) -> str:
     for env_id in (ENV_ID, LEARNER_ENV_ID):
         env = gym.make(env_id)
         try:
-            demo_policy(options, env)
-            return env_id
+            return env_id, env, demo_policy(options, env)
         except ModelFileError as exc:  # a model that does not fit; the other view may
-            first = first or exc
-        finally:
             env.close()
+            first = first or exc
+        except BaseException:
+            env.close()
+            raise
     assert first is not None
     raise first
+
+
+def demo_env_id(options: DemoOptions) -> str:
+    """The version of the paper's scene the policy flies (:func:`open_demo`)."""
+    env_id, env, _ = open_demo(options)
+    env.close()
+    return env_id
 
 
 def check_policy(options: DemoOptions) -> None:
@@ -228,8 +237,6 @@ def run_demo(
 ) -> DemoResult:
     """Run, score and render the demo; ``progress(done, total)`` is called every tick, of the
     episode and then of the drawing (``total`` counts both)."""
-    import gymnasium as gym
-
     from baselines.evaluation.harness import (
         goal_rows,
         run_episode,
@@ -239,13 +246,7 @@ def run_demo(
     )
 
     started = cpu_seconds()
-    env_id = demo_env_id(options)
-    env = gym.make(env_id)
-    try:
-        policy = demo_policy(options, env)
-    except BaseException:
-        env.close()
-        raise
+    env_id, env, policy = open_demo(options)
     options.out.mkdir(parents=True, exist_ok=True)
     base: Any = env.unwrapped  # the SGCEnv: scenario, sim, max_steps
     scenario = base.scenario
