@@ -28,6 +28,7 @@ from baselines.models.per_body import (  # noqa: E402
     body_gains,
 )
 from sgc_env.observation import BODY_BLOCK_SIZE  # noqa: E402
+from tests.baselines.models.pd_law import set_pd_law  # noqa: E402
 
 RECIPE = Path(__file__).resolve().parents[3] / "benchmarks" / "hyperparams" / "ppo_threerod"
 RANDOM_ID = next(i for i in sgc_env.ENV_IDS if i.startswith("SGCThreeRodsRandom-"))
@@ -103,26 +104,14 @@ def test_gains_follow_the_limits_the_agent_does_not_observe() -> None:
         body_gains(gym.make("SGCPoint-v0"))
 
 
-def _set_linear_law(policy: PerBodyPolicy, kp: float, kd: float) -> None:
-    """No hidden layer: the head reads the 32 features; a PD law on both tracks' error and
-    rate, in acceleration units (the features' scales: 0.05 and 0.5)."""
-    weight = th.zeros(BODY_ACTIONS, BODY_FEATURES)
-    for k, start in ((0, 0), (1, BODY_FEATURES // 2)):
-        for axis in range(3):
-            weight[3 * k + axis, start + axis] = -kp * 0.05 / REFERENCE_ACCELERATION
-            weight[3 * k + axis, start + 3 + axis] = -kd * 0.5 / REFERENCE_ACCELERATION
-    with th.no_grad():
-        policy.action_net.linear.weight.copy_(weight)
-        policy.action_net.linear.bias.zero_()
-
-
 def test_a_saved_model_flies_the_paper_scene_with_that_scenes_gains(tmp_path: Path) -> None:
     """A hand-set linear law (not learned) saved from the random family, whose limits are
     twice the paper scene's, meets the paper scene's goals when loaded on it: the loader binds
     the paper scene's gains. Bound to the random family's gains it drives at half the
     acceleration and misses goals."""
     model = _model(RANDOM_ID, net_arch=[], features_extractor_kwargs=dict(squash=None))
-    _set_linear_law(model.policy, 900.0, 60.0)
+    assert model.policy.mlp_extractor.width == BODY_FEATURES
+    set_pd_law(model.policy, 900.0, 60.0)
     path = tmp_path / "linear.zip"
     model.save(path)
     loaded = load_sb3_model(path, env=gym.make(PAPER_ID))

@@ -20,12 +20,11 @@ from baselines.agents.smooth_ppo import SmoothPPO  # noqa: E402
 from baselines.evaluation.harness import evaluate  # noqa: E402
 from baselines.models.model_files import load_sb3_model  # noqa: E402
 from baselines.models.per_body import (  # noqa: E402
-    BODY_ACTIONS,
-    REFERENCE_ACCELERATION,
     LearnerViewBodies,
     PerBodyPolicy,
 )
 from sgc_env.envs.learner_view import LEARNER_BODY_SIZE, LEARNER_TRACK_SIZE  # noqa: E402
+from tests.baselines.models.pd_law import set_pd_law  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 RANDOM_ID, PAPER_ID, ROD_ID = "SGCThreeRodsRandom-v3", "SGCThreeRods-v2", "SGCRod-v1"
@@ -81,15 +80,8 @@ def test_a_saved_linear_law_flies_the_paper_scene_with_its_gains(tmp_path: Path)
     family, meets the paper scene's goals when loaded on it (the loader binds that scene's
     gains, half the random family's action per unit of acceleration)."""
     model = _model(RANDOM_ID, net_arch=[])
-    weight = th.zeros(BODY_ACTIONS, WIDTH)
-    kp, kd = 900 * 0.05 / REFERENCE_ACCELERATION, 60 * 0.5 / REFERENCE_ACCELERATION
-    for k in range(2):
-        for axis in range(3):
-            weight[3 * k + axis, k * LEARNER_TRACK_SIZE + axis] = -kp
-            weight[3 * k + axis, k * LEARNER_TRACK_SIZE + 3 + axis] = -kd
-    with th.no_grad():
-        model.policy.action_net.linear.weight.copy_(weight)
-        model.policy.action_net.linear.bias.zero_()
+    assert model.policy.mlp_extractor.width == WIDTH
+    set_pd_law(model.policy, 900.0, 60.0)
     path = tmp_path / "linear.zip"
     model.save(path)
     loaded = load_sb3_model(path, env=gym.make(PAPER_ID))
