@@ -7,28 +7,20 @@ slow tests. A failure means: rerun ``python scripts/paste_results.py NAME --run`
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import shlex
-import sys
 from pathlib import Path
 
 import pytest
 
 from baselines.cli.main import main
+from tests.script_module import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _paste():
-    spec = importlib.util.spec_from_file_location(
-        "paste_results", ROOT / "scripts" / "paste_results.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return load_script("paste_results")
 
 
 paste = _paste()

@@ -2,22 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[3]
+from tests.script_module import load_script
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location(
-        "zoo_seed_table", ROOT / "scripts" / "zoo_seed_table.py"
-    )
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("zoo_seed_table")
 
 
 def test_training_seconds_span_every_monitor_file(tmp_path: Path) -> None:

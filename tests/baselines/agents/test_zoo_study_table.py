@@ -2,24 +2,18 @@
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[3]
+from tests.script_module import load_script
+
 HEADER = (",number,value,datetime_start,datetime_complete,duration,params_learning_rate,"
           "user_attrs_gamma,user_attrs_batch_size,state\n")  # fmt: skip
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location(
-        "zoo_study_table", ROOT / "scripts" / "zoo_study_table.py"
-    )
-    assert spec and spec.loader
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("zoo_study_table")
 
 
 def _report(folder: Path, rows: str, stamp: int = 1700000000) -> None:

@@ -2,21 +2,13 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-ROOT = Path(__file__).resolve().parents[3]
+from tests.script_module import load_script
 
 
 def _paste_module():
-    path = ROOT / "scripts" / "paste_leaderboard.py"
-    spec = importlib.util.spec_from_file_location("paste_leaderboard", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("paste_leaderboard")
 
 
 DOC = """intro

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import pytest
+
+from tests.script_module import load_script
 
 pytest.importorskip("stable_baselines3")
 
@@ -14,11 +15,7 @@ ROOT = Path(__file__).resolve().parents[3]
 
 
 def _seed_table():
-    spec = importlib.util.spec_from_file_location("seed_table", ROOT / "scripts" / "seed_table.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("seed_table")
 
 
 @pytest.mark.parametrize("name", ["recipes.yml", "archive/recipes.yml"])

@@ -114,14 +114,10 @@ def test_rollout_and_evaluate_report_the_angular_figures(tmp_path, capsys):
 
 
 def _kink_rows(episodes: int, policy: str = "expert") -> list[dict]:
-    import importlib.util
-    from pathlib import Path
 
-    path = Path(__file__).resolve().parents[3] / "scripts" / "kink_table.py"
-    spec = importlib.util.spec_from_file_location("kink_table", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    from tests.script_module import load_script
+
+    module = load_script("kink_table")
     rows = module.compare("SGCThreeRods-v1", 1, 0, policy)
     return rows + module.compare("SGCThreeRodsRandom-v2", episodes, 10000, policy)
 
@@ -169,14 +165,10 @@ def test_kinks_against_minimum_jerk_every_rod_within_2x():
 def test_expert_smooth_stays_within_the_force_and_torque_caps():
     """The same scenes: no action entry beyond 1 (the env would clip it to the body's force or
     torque cap), every goal met to 1e-9 (scripts/action_limits.py)."""
-    import importlib.util
-    from pathlib import Path
 
-    path = Path(__file__).resolve().parents[3] / "scripts" / "action_limits.py"
-    spec = importlib.util.spec_from_file_location("action_limits", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    from tests.script_module import load_script
+
+    module = load_script("action_limits")
     rows = module.rows("expert-smooth", 10, 10000)
     assert len(rows) == 11
     for r in rows:
