@@ -54,6 +54,13 @@ def _short(text: str) -> str:
         return escaped(text, 40)
 
 
+def _trial_number(text: Any, where: str) -> int:
+    """A trial's number as an int: it names a folder, so a report cannot choose the path."""
+    if not (isinstance(text, str) and text.isdecimal() and len(text) <= 9):
+        raise ValueError(f"{where}: trial number {escaped(repr(text), 40)} is not a count")
+    return int(text)
+
+
 def newest_report(folder: Path) -> tuple[Path, dict[str, str]]:
     """The newest ``report_*.csv`` of one family's folder and the fields of its name."""
     found = [(m, p) for p in folder.glob("report_*.csv") if (m := _REPORT.fullmatch(p.name))]
@@ -93,7 +100,8 @@ def study_row(folder: Path) -> dict[str, Any]:
         "pruner": name["pruner"], "complete": len(done),
         "pruned": sum(r["state"] == "PRUNED" for r in rows),
         "failed": sum(r["state"] == "FAIL" for r in rows),
-        "best": max(values), "median": float(np.median(values)), "best_trial": best["number"],
+        "best": max(values), "median": float(np.median(values)),
+        "best_trial": _trial_number(best.get("number"), where),
         "settings": settings, "seconds": round(seconds),
     }  # fmt: skip
 

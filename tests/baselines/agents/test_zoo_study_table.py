@@ -41,7 +41,8 @@ def test_a_row_counts_trials_and_reads_the_best_settings(tmp_path: Path) -> None
     ("rows", "message"),
     [("0,0,inf,a,b,0 days 00:00:01,0.1,0.5,8,COMPLETE\n", "trial 0: inf is not finite"),
      ("0,0,x,a,b,0 days 00:00:01,0.1,0.5,8,COMPLETE\n", "trial 0: 'x' is not a number"),
-     ("0,0,,a,b,0 days 00:00:01,0.1,0.5,8,FAIL\n", "no completed trial")],
+     ("0,0,,a,b,0 days 00:00:01,0.1,0.5,8,FAIL\n", "no completed trial"),
+     ("0,../x,5,a,b,0 days 00:00:01,0.1,0.5,8,COMPLETE\n", "trial number '../x' is not a count")],
 )  # fmt: skip
 def test_a_bad_report_names_the_file_and_the_trial(tmp_path: Path, rows: str, message: str) -> None:
     _report(tmp_path / "td3", rows)
