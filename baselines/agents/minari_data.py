@@ -35,9 +35,10 @@ import gymnasium as gym
 import minari
 import numpy as np
 from minari.data_collector import EpisodeBuffer
+from minari.dataset.minari_dataset import DATASET_ID_RE
 from minari.storage.datasets_root_dir import get_dataset_path
 
-__all__ = ["fixed_info", "float64_action_space", "record_minari"]
+__all__ = ["check_dataset_id", "fixed_info", "float64_action_space", "record_minari"]
 
 _GOAL_KEYS = ("position_error", "orientation_error")
 
@@ -84,6 +85,17 @@ def _datasets_root(path: str) -> Iterator[None]:
             os.environ["MINARI_DATASETS_PATH"] = saved
 
 
+def check_dataset_id(dataset_id: str) -> None:
+    """Minari's id form with its version required: an unversioned id fails deep inside Minari,
+    and the id names the folder written, so it is checked before any work."""
+    match = DATASET_ID_RE.fullmatch(dataset_id)
+    if match is None or match.group("version") is None:
+        raise ValueError(
+            f"dataset_id: expected (namespace/)name-v<version>, e.g. 'sgc/point/expert-v0'; "
+            f"got {dataset_id!r}"
+        )
+
+
 def _write_in_place(dataset_id: str, **create: Any) -> minari.MinariDataset:
     """``minari.create_dataset_from_buffers`` into a staging folder, renamed into place."""
     target = get_dataset_path(dataset_id)
@@ -117,6 +129,7 @@ def record_minari(
     from sgc_env import check_env_id
 
     check_env_id(env_id)
+    check_dataset_id(dataset_id)
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     env = gym.make(env_id, **(env_kwargs or {}))

@@ -64,7 +64,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _run_minari(args: argparse.Namespace) -> int:
     try:
-        from baselines.agents.minari_data import record_minari
+        from baselines.agents.minari_data import check_dataset_id, record_minari
     except ImportError as exc:
         raise UsageError(
             f"--format minari needs the minari extra ({exc}); "
@@ -72,6 +72,10 @@ def _run_minari(args: argparse.Namespace) -> int:
         ) from None
     if args.push_scale or args.push_spin or args.push_start:
         raise UsageError("--format minari records unpushed episodes only")
+    try:
+        check_dataset_id(args.out)
+    except ValueError as exc:
+        raise UsageError(f"--out: {exc}") from None
     dataset = record_minari(args.env, args.episodes, args.seed, args.out, args.env_kwargs)
     print(
         f"{dataset.total_episodes} episodes, {dataset.total_steps} steps of {args.env} -> "

@@ -91,3 +91,17 @@ def test_an_interrupted_write_leaves_no_dataset(
     assert minari.load_dataset("sgc/point/cut-v0").total_episodes == 1
     with pytest.raises(ValueError, match="already exists"):
         record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+
+
+@pytest.mark.parametrize("dataset_id", ["sgc-point", "sgc/point", "../escape-v0", "a b-v0"])
+def test_a_malformed_dataset_id_is_refused_before_any_work(
+    datasets: Path, capsys: pytest.CaptureFixture[str], dataset_id: str
+) -> None:
+    with pytest.raises(ValueError, match="dataset_id: expected"):
+        record_minari("SGCPoint-v0", 1, 0, dataset_id)
+    argv = ["demos", "--env", "SGCPoint-v0", "--episodes", "1", "--format", "minari",
+            "--out", dataset_id]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out: dataset_id: expected" in err[0], err
+    assert list(datasets.iterdir()) == []
