@@ -17,7 +17,7 @@ from typing import Any
 
 from baselines.common.network_caps import check_policy_kwargs
 from baselines.common.shipped import hyperparams_file
-from baselines.common.value_types import describe, matches
+from baselines.common.value_types import check_weight, describe, matches
 from baselines.models.features import ACTIVATIONS
 from sgc_env.scenario.bounded import check_count, escaped, load_yaml, read_text
 
@@ -289,9 +289,10 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
     except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs, noise_std and action_rate "
                          "must be finite numbers") from None  # fmt: skip
-    if not (math.isfinite(action_rate) and action_rate >= 0):
-        raise ValueError(f"{path}: {env_id}: action_rate must be a finite weight >= 0, "
-                         f"got {entry.get('action_rate')!r}")  # fmt: skip
+    try:
+        check_weight(action_rate, "action_rate")
+    except ValueError as exc:
+        raise ValueError(f"{path}: {env_id}: {exc}") from None
     shaping = entry.get("reward_shaping", "none")
     if shaping not in ("none", "smooth", "smooth_alive"):
         raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none', 'smooth' or "
