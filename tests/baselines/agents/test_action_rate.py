@@ -63,5 +63,6 @@ def test_a_hyperparameter_file_sets_it_and_a_bad_value_names_the_file(tmp_path: 
     assert load_hyperparams("ppo", "SGCPoint-v1", tmp_path).action_rate == 2.5
     (tmp_path / "ppo.yml").write_text("SGCPoint-v1:\n  n_timesteps: 100\n  policy: MlpPolicy\n"
                                       "  action_rate: -1\n")  # fmt: skip
-    with pytest.raises(ValueError, match=r"ppo.yml: SGCPoint-v1: action_rate: expected a finite weight >= 0, got -1"):
+    expected = r"ppo.yml: SGCPoint-v1: action_rate: expected a finite weight >= 0, got -1"
+    with pytest.raises(ValueError, match=expected):
         load_hyperparams("ppo", "SGCPoint-v1", tmp_path)
