@@ -96,11 +96,18 @@ def check_dataset_id(dataset_id: str) -> None:
         )
 
 
-def _write_in_place(dataset_id: str, **create: Any) -> minari.MinariDataset:
-    """``minari.create_dataset_from_buffers`` into a staging folder, renamed into place."""
+def check_dataset_free(dataset_id: str) -> Path:
+    """Where dataset ``dataset_id`` goes; a ``ValueError`` if a dataset is there already.
+    Checked before the rollouts (so a taken id costs no work) and again at the rename."""
     target = get_dataset_path(dataset_id)
     if target.exists():
         raise ValueError(f"dataset_id: a dataset {dataset_id!r} already exists at {target}")
+    return target
+
+
+def _write_in_place(dataset_id: str, **create: Any) -> minari.MinariDataset:
+    """``minari.create_dataset_from_buffers`` into a staging folder, renamed into place."""
+    target = check_dataset_free(dataset_id)
     root = get_dataset_path()
     with tempfile.TemporaryDirectory(dir=root, prefix=".staging-") as staging:
         with _datasets_root(staging):
@@ -130,6 +137,7 @@ def record_minari(
 
     check_env_id(env_id)
     check_dataset_id(dataset_id)
+    check_dataset_free(dataset_id)
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     env = gym.make(env_id, **(env_kwargs or {}))

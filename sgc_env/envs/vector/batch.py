@@ -21,6 +21,9 @@ when :attr:`Batch.envs` hands them out. The goal env steps each sub-env's own
 
 from __future__ import annotations
 
+import gc
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -64,6 +67,25 @@ per step cost about the same for 1 sub-env as for 64 (~1.5 ms under load), more 
 sub-envs' own Python; measured against the per-sub-env path, numpy/per-sub-env env-steps/s
 were 0.31, 0.47, 0.90, 1.40 for 2, 4, 8, 16 rods and 0.45, 0.61, 1.07, 1.43 for three-rod
 scenes."""
+
+
+@contextmanager
+def collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector held off for the block (left as it was if off).
+
+    Why: a batched step allocates thousands of short-lived lists and tuples (PyBullet's
+    arguments and readings) that die with the step and hold no cycles, but their count
+    triggers collections of everything the sub-envs keep (for random three-rod scenes a
+    noticeable share of the step; none for the rod). The count falls back as the step's
+    objects are freed, so collection resumes after the block as before."""
+    if not gc.isenabled():
+        yield
+        return
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.enable()
 
 
 def scenes_per_world(num_envs: int, objects: int) -> int:
@@ -192,7 +214,8 @@ class Batch:
             for i in range(len(self._envs)):
                 fast.load(i, record=False)
             self._handed = False
-        rewards, terminated, at_limit, events = fast.step(indices, values)
+        with collector_paused():
+            rewards, terminated, at_limit, events = fast.step(indices, values)
         self._behind = True
         truncated = ~terminated & at_limit
         if len(indices) == len(self._envs):  # sorted, distinct indices: every sub-env
@@ -206,6 +229,10 @@ class Batch:
     def step(self, indices: list[int], values: list[list[float]]) -> list[StepResult]:
         """One control step of the listed sub-envs (their clipped actions) in one world step;
         the time limit (TimeLimit's rule: truncate once ``elapsed >= limit``) applied."""
+        with collector_paused():
+            return self._step(indices, values)
+
+    def _step(self, indices: list[int], values: list[list[float]]) -> list[StepResult]:
         envs = self._envs
         by_world: dict[int, list[Any]] = {}
         for i, v in zip(indices, values, strict=True):

@@ -137,3 +137,36 @@ def _cycles(n: int, base: int) -> None:
 def test_a_thousand_make_close_cycles_leak_nothing() -> None:
     """~40 ms each (PyBullet's connect), so slow."""
     _cycles(1000, len(connected_clients()))
+
+
+def test_a_step_holds_the_collector_off_and_leaves_it_as_it_was(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The batched step runs with Python's cyclic collector off (its many short-lived lists
+    trigger collections for nothing) and hands it back as found: on, off, or after an error."""
+    import gc
+
+    seen: list[bool] = []
+    step = batch_module.BatchTask.step
+
+    def watched(self: object, *args: object) -> object:
+        seen.append(gc.isenabled())
+        return step(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(batch_module.BatchTask, "step", watched)
+    env = gym.make_vec("SGCRod-v0", 12, vectorization_mode="vector_entry_point")
+    env.reset(seed=0)
+    assert gc.isenabled()
+    env.step(np.zeros(env.action_space.shape, np.float32))
+    assert seen == [False] and gc.isenabled()
+    gc.disable()
+    try:
+        env.step(np.zeros(env.action_space.shape, np.float32))
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+    env.close()
+    with pytest.raises(RuntimeError, match="inside"):
+        with batch_module.collector_paused():
+            raise RuntimeError("inside")
+    assert gc.isenabled()
