@@ -37,6 +37,7 @@ def _rss_mb(children: bool) -> float:
 def child(env_id: str, n: int, kind: str, steps: int, rollout: int) -> dict[str, float]:
     """One measurement (runs in its own process)."""
     import numpy as np
+    from bench_env import hover_action  # scripts/ is on the path when run as a script
 
     from baselines.agents.sb3_vec_env import BatchedVecEnv, make_sgc_vec
 
@@ -44,12 +45,8 @@ def child(env_id: str, n: int, kind: str, steps: int, rollout: int) -> dict[str,
     env = BatchedVecEnv(env_id, n) if kind == "batched" else make_sgc_vec(env_id, n, vec=kind)
     env.seed(0)
     env.reset()
-    base = env.get_attr("scenario", [0])[0]
     shape = env.action_space.shape
-    hover = np.zeros(shape, np.float32)
-    per = shape[0] // len(base.bodies)
-    for i, b in enumerate(base.bodies):
-        hover[i * per + 2] = b.mass * 9.81 / b.force_limit
+    hover = hover_action(env.get_attr("unwrapped", [0])[0])
     rng = np.random.default_rng(0)
     t_steps = max(steps // n, 10)
     actions = (hover + rng.normal(0.0, 0.1, (t_steps + 5, n, *shape))).astype(np.float32)

@@ -29,6 +29,7 @@ from bench_env import hover_action  # scripts/ is on the path when run as a scri
 import sgc_env
 from baselines.agents.sb3_vec_env import make_sgc_vec
 from sgc_env.envs.sgc_env import SGCEnv
+from sgc_env.envs.vector.batch import check_num_envs
 from sgc_env.scenes import family
 from sgc_env.simulator import pybullet as pb
 
@@ -43,9 +44,9 @@ class Timers:
         self.spent = dict.fromkeys(TIMERS, 0.0)
         self.calls = dict.fromkeys(TIMERS, 0)
         preset = gym.spec(env_id).kwargs.get("random_scenario")
-        self._targets: list[tuple[Any, str, str]] = [(SGCEnv, "reset", "reset")]
+        self._targets: list[tuple[Any, str]] = [(SGCEnv, "reset")]
         if preset is not None:
-            self._targets.append((type(family(preset)), "draw", "draw"))
+            self._targets.append((type(family(preset)), "draw"))
         self._originals: list[tuple[Any, str, Callable[..., Any]]] = []
 
     def _timed(self, key: str, method: Callable[..., Any]) -> Callable[..., Any]:
@@ -62,10 +63,10 @@ class Timers:
         return timed
 
     def __enter__(self) -> Timers:
-        for owner, name, key in self._targets:
+        for owner, name in self._targets:
             original = owner.__dict__[name]
             self._originals.append((owner, name, original))
-            setattr(owner, name, self._timed(key, original))
+            setattr(owner, name, self._timed(name, original))
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -162,6 +163,13 @@ def main() -> None:
     parser.add_argument("--ticks", type=int, default=320, help="steps of all N sub-envs timed")
     parser.add_argument("--repeats", type=int, default=2)
     args = parser.parse_args()
+    for name in ("ticks", "repeats"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name}: expected an int >= 1, got {getattr(args, name)}")
+    try:
+        check_num_envs(args.n)
+    except ValueError as err:
+        parser.error(f"--n: {err}")
     ids = (*sgc_env.ENV_IDS, *sgc_env.LEARNER_IDS)
     for env_id in args.ids:
         if env_id not in ids:
