@@ -13,7 +13,7 @@ mkdir "$work/src"
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$work/src"
 .venv/bin/python -m pip wheel --no-deps --progress-bar off -w "$work/dist" "$work/src" >/dev/null
 wheel="$(ls "$work"/dist/sgc-*.whl)"
-unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint-v0.(zip|md)"
+unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint-v0.(zip|md)|export/viewer.html"
 cards="$(unzip -l "$wheel" | grep -c "baselines/checkpoints/.*\.md$")"
 test "$cards" -eq "$(ls baselines/checkpoints/*.md | wc -l)"  # every shipped model's card
 step "2/4 install $(basename "$wheel")[rl] into a fresh venv"
@@ -34,4 +34,6 @@ step "4/4 sgc evaluate: the expert and the shipped models (a clone, one learned 
 "$work/venv/bin/sgc" evaluate --env SGCPoint-v0 --policy expert,shipped:SGCPoint-v0,shipped:ppo_schedule_SGCPoint-v0 \
     --episodes 2 --no-plots --out evaluate
 test -s evaluate/scorecard.md && test -s train/final_model.zip
+"$work/venv/bin/sgc" demo --no-video --out demo  # the glTF file and its viewer page, from the wheel
+test -s demo/three_rods.glb && grep -q GLTFLoader demo/viewer.html
 step "wheel check passed"

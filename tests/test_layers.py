@@ -90,6 +90,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("sgc_env.scenes",),
     ("sgc_env.episode_steps", "sgc_env.observation", "sgc_env.simulator", "sgc_env.metrics"),
     ("sgc_env.render",),
+    ("sgc_env.export",),  # the motion as glTF
     ("sgc_env.envs",),
     ("sgc_env",),  # the package: registers the ids
     ("sgc_env.ladder", "sgc_env.env_cards"),

@@ -13,7 +13,9 @@ world is a client of its own, physics is untouched). The episode runs first and 
 afterwards, so that the pierce is known when the frames are drawn.
 Outputs: an MP4 and a GIF at real time, an
 8-frame plate sheet in the spirit of the paper's Plates 1-8, deviation and speed plots per rod
-(named and coloured as in the video), ``goals.csv``, ``summary.json`` and ``rods.json``.
+(named and coloured as in the video), ``goals.csv``, ``summary.json``, ``rods.json`` and the
+flight as a keyframed glTF scene, ``three_rods.glb`` (rods drawn as thick as in the video),
+with ``viewer.html`` to show it in a browser.
 """
 
 from __future__ import annotations
@@ -30,13 +32,15 @@ import numpy as np
 
 from baselines.figures.demo_camera import camera_at
 from baselines.figures.episode_gif import gif_durations, write_gif
+from sgc_env.export.gltf import VIEWER_PAGE, Motion, motion_of, write_glb, write_viewer
 from sgc_env.paper.end_rules import END_RULES
 from sgc_env.render import TRAIL_SECONDS, Caster, Painter, RenderWorld, Trail
 from sgc_env.simulator import pybullet
 
 __all__ = [
-    "DemoOptions", "DemoResult", "DemoScene", "check_policy", "cpu_seconds", "demo_env_id",
-    "demo_policy", "gif_durations", "open_demo", "pierce_times", "run_demo",
+    "GLTF_FILE", "BallCarry", "DemoOptions", "DemoResult", "DemoScene", "check_policy",
+    "cpu_seconds", "demo_env_id", "demo_motion", "demo_policy", "gif_durations", "open_demo",
+    "pierce_times", "run_demo",
 ]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v1"
@@ -50,19 +54,23 @@ ROD_DRAW_RADIUS = 0.075
 BALL_SLIDE = 0.3
 """Seconds a pierced ball takes to slide from the tip to the middle of its rod."""
 VIDEO_FPS = 30
+GLTF_FILE = "three_rods.glb"
+"""The flight as glTF 2.0 binary (:mod:`sgc_env.export.gltf`), for Blender and the web."""
 
 
 @dataclass(frozen=True)
 class DemoOptions:
     """What to run and render. ``policy``: a spec of :func:`baselines.policies.make_policy`;
     ``end_rule``: the expert's end-velocity rule (for ``policy="expert"`` only);
-    ``trust_model``: unpickle model files (``--trust-model``)."""
+    ``trust_model``: unpickle model files (``--trust-model``); ``gltf``: write the flight as
+    :data:`GLTF_FILE`."""
 
     out: Path
     width: int = 960
     height: int = 540
     gif_scale: int = 2
     video: bool = True
+    gltf: bool = True
     end_rule: str = "tangent"
     policy: str = "expert"
     trust_model: bool = False
@@ -95,7 +103,7 @@ class DemoOptions:
 @dataclass
 class DemoResult:
     """Where everything went, the scorecard, the CPU seconds the run took, and the video's
-    frames with their times (for ``sgc demo --compare``)."""
+    frames with their times and the flight's motion (for ``sgc demo --compare``)."""
 
     files: dict[str, Path] = field(default_factory=dict)
     summary: dict[str, Any] = field(default_factory=dict)
@@ -104,6 +112,8 @@ class DemoResult:
     label: str = "expert"
     frames: list[np.ndarray] = field(default_factory=list)
     frame_times: list[float] = field(default_factory=list)
+    motion: Motion | None = None
+    scenario: Any = None
 
 
 _AT_IMPORT = os.times()
@@ -148,28 +158,25 @@ def pierce_times(
     return out
 
 
-class DemoScene:
-    """The demo's render world (thick rod shells, the bullseye board) with the pierced balls
-    carried on their rods. ``pierce``: when each rod pierced its ball (None: never; see
-    :func:`pierce_times`)."""
+class BallCarry:
+    """Where the demo draws each prop: a red ball its rod pierced rides on the rod from the
+    pierce on (sliding from the tip to the middle in :data:`BALL_SLIDE` s), every other prop
+    is where its own path puts it. ``pierce``: when each rod pierced its ball (None: never;
+    see :func:`pierce_times`). The video and the glTF file draw the same places."""
 
     def __init__(self, scenario: Any, pierce: Sequence[float | None]) -> None:
         from sgc_env.scenes import three_rods
 
         if len(pierce) != len(scenario.bodies):
             raise ValueError(f"pierce: expected one time per rod, got {len(pierce)}")
-        self.world = RenderWorld(scenario, ROD_DRAW_RADIUS)
-        self.client = self.world.client
         self.props = scenario.props
         self.ball_index = ball_indices(scenario)
-        self.ball_uids = [self.world.prop_uids[k] for k in self.ball_index]
-        self.rods = self.world.body_uids
         self.tip = np.asarray(three_rods.TIP, float)
         self.pierce = list(pierce)
 
-    def update(self, now: float, positions: Sequence[Sequence[float]],
-               orientations: Sequence[Sequence[float]]) -> list[Caster]:  # fmt: skip
-        """Pose rods (as the env has them) and props for time ``now``; the shadow casters."""
+    def positions(self, now: float, positions: Sequence[Sequence[float]],
+                  orientations: Sequence[Sequence[float]]) -> list[np.ndarray]:  # fmt: skip
+        """Every prop's drawn position at time ``now``, the rods posed as the env has them."""
         props = [np.asarray(p.position_at(now), float) for p in self.props]
         for k, pierced, position, orientation in zip(self.ball_index, self.pierce, positions,
                                                      orientations, strict=True):  # fmt: skip
@@ -179,7 +186,25 @@ class DemoScene:
             along = self.tip * (1.0 - slide * slide * (3.0 - 2.0 * slide))
             axis = np.asarray(pybullet.getMatrixFromQuaternion(orientation)).reshape(3, 3)
             props[k] = np.asarray(position, float) + axis @ along
-        return self.world.update(positions, orientations, props)
+        return props
+
+
+class DemoScene:
+    """The demo's render world (thick rod shells, the bullseye board) with the props where
+    :class:`BallCarry` puts them."""
+
+    def __init__(self, scenario: Any, pierce: Sequence[float | None]) -> None:
+        self.carry = BallCarry(scenario, pierce)
+        self.world = RenderWorld(scenario, ROD_DRAW_RADIUS)
+        self.client = self.world.client
+        self.ball_uids = [self.world.prop_uids[k] for k in self.carry.ball_index]
+        self.rods = self.world.body_uids
+
+    def update(self, now: float, positions: Sequence[Sequence[float]],
+               orientations: Sequence[Sequence[float]]) -> list[Caster]:  # fmt: skip
+        """Pose rods (as the env has them) and props for time ``now``; the shadow casters."""
+        return self.world.update(positions, orientations,
+                                 self.carry.positions(now, positions, orientations))  # fmt: skip
 
     def close(self) -> None:
         self.world.close()
@@ -264,7 +289,12 @@ def run_demo(
     finally:
         env.close()
 
-    result = DemoResult(label=options.label)
+    result = DemoResult(label=options.label, scenario=scenario)
+    result.motion = demo_motion(scenario, ticks, result.label)
+    if options.gltf:
+        result.files[GLTF_FILE] = write_glb(options.out / GLTF_FILE, scenario, [result.motion],
+                                            rod_radius=ROD_DRAW_RADIUS)  # fmt: skip
+        result.files[VIEWER_PAGE] = write_viewer(options.out, GLTF_FILE)
     if options.video:
         drawn = None if progress is None else (lambda step: progress(base.max_steps + step, total))
         frame_every = round(base.control_frequency / VIDEO_FPS)
@@ -282,6 +312,17 @@ def run_demo(
         result.files.update(_videos(result.frames, result.frame_times, options))
     result.cpu_s = cpu_seconds() - started
     return result
+
+
+def demo_motion(scenario: Any, ticks: Sequence[Mapping[str, Any]], label: str) -> Motion:
+    """The flight of the reset's and every step's ``ticks``, with the props where the video
+    draws them (:class:`BallCarry`)."""
+    times = [float(info.get("time", 0.0)) for info in ticks]
+    tips = np.stack([np.asarray(info["point_position"], float) for info in ticks])
+    carry = BallCarry(scenario, pierce_times(scenario, times, tips))
+    props = np.array([carry.positions(now, info["body_position"], info["body_orientation"])
+                      for now, info in zip(times, ticks, strict=True)])  # fmt: skip
+    return motion_of(label, ticks, props.reshape(len(times), len(scenario.props), 3))
 
 
 def _draw(

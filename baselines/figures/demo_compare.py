@@ -19,9 +19,11 @@ import numpy as np
 
 from baselines.figures.demo import DemoOptions, DemoResult, run_demo, write_mp4
 
-__all__ = ["COMPARE_VIDEO", "fly_demos", "side_by_side", "write_side_by_side"]
+__all__ = ["COMPARE_GLTF", "COMPARE_VIDEO", "fly_demos", "side_by_side", "write_side_by_side"]
 
 COMPARE_VIDEO = "compare.mp4"
+COMPARE_GLTF = "compare.glb"
+"""Both flights in one glTF scene: a group and an animation per policy, named by its label."""
 
 
 def _caption(panel: np.ndarray, lines: Sequence[str]) -> np.ndarray:
@@ -61,6 +63,16 @@ def write_side_by_side(left: DemoResult, right: DemoResult, out: Path) -> Path:
     return write_mp4(out / COMPARE_VIDEO, side_by_side(left, right))
 
 
+def write_compare_glb(results: Sequence[DemoResult], path: Path) -> Path:
+    """Every run's flight in one glTF scene of the paper's three rods (every version of the
+    demo flies the same bodies, props and nails); ``path``."""
+    from baselines.figures.demo import ROD_DRAW_RADIUS
+    from sgc_env.export.gltf import write_glb
+
+    motions = [r.motion for r in results if r.motion is not None]
+    return write_glb(path, results[0].scenario, motions, rod_radius=ROD_DRAW_RADIUS)
+
+
 def fly_demos(
     options: Sequence[DemoOptions],
     labels: Sequence[str],
@@ -68,7 +80,8 @@ def fly_demos(
     progress: Callable[[str], Callable[[int, int], None]],
 ) -> tuple[list[DemoResult], list[Path]]:
     """Run the demo of each option into ``folder`` (two: ``folder/<label>`` each, then the
-    side-by-side video and both scorecards); the results and every file written.
+    side-by-side video, both flights in one glTF scene and both scorecards); the results and
+    every file written.
     ``progress(label)`` gives each run's ``progress(done, total)``."""
     from baselines.evaluation.harness import write_summary_json
 
@@ -80,6 +93,11 @@ def fly_demos(
     files = [path for result in results for path in result.files.values()]
     if compare:
         files.append(write_side_by_side(results[0], results[1], folder))
+        if all(o.gltf for o in options):
+            from sgc_env.export.gltf import write_viewer
+
+            files.append(write_compare_glb(results, folder / COMPARE_GLTF))
+            files.append(write_viewer(folder, COMPARE_GLTF))
         summaries = {r.label: r.summary for r in results}
         files.append(write_summary_json(summaries, folder / "summary.json"))
     return results, files

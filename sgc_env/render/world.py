@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -26,12 +26,31 @@ from sgc_env.simulator import pybullet
 if TYPE_CHECKING:
     from sgc_env.scenario import Scenario
 
-__all__ = ["RenderWorld", "box_corners"]
+__all__ = ["RING_THICKNESS", "RING_TURN", "RenderWorld", "Ring", "box_corners", "bullseye_rings"]
 
 PARKED = (0.0, 0.0, -1e3)
 BULLSEYE = ((1.6, (0.85, 0.1, 0.1, 1.0)), (1.1, (0.95, 0.95, 0.95, 1.0)),
             (0.6, (0.85, 0.1, 0.1, 1.0)), (0.2, (0.95, 0.85, 0.2, 1.0)))  # fmt: skip
 """Ring radii (m) and colours on the paper's 6 x 4.4 m board, outermost first."""
+RING_THICKNESS = 0.01
+"""Each ring is a disc this thick (m): a cylinder whose axis :data:`RING_TURN` lays along x."""
+RING_TURN: tuple[float, ...] = tuple(pybullet.getQuaternionFromEuler([0.0, np.pi / 2, 0.0]))
+"""A quarter turn about y (x, y, z, w): a cylinder's z axis onto the board's normal x."""
+
+
+class Ring(NamedTuple):
+    """One bullseye ring: its radius and colour, and its centre's x offset from the board's."""
+
+    radius: float
+    color: tuple[float, float, float, float]
+    offset: float
+
+
+def bullseye_rings(half: Sequence[float]) -> list[Ring]:
+    """The rings on the -x face of a board of half extents ``half``, each a little further
+    out than the one it covers (so the depth test draws them in order)."""
+    face = -float(half[0]) - 0.005
+    return [Ring(radius, color, face - 0.006 * k) for k, (radius, color) in enumerate(BULLSEYE)]
 
 
 def box_corners(centre: Sequence[float], half: Sequence[float]) -> np.ndarray:
@@ -80,15 +99,14 @@ class RenderWorld:
 
     def _bullseye(self, centre: Sequence[float], half: Sequence[float]) -> None:
         """Rings on the board's -x face (visual only)."""
-        face_x = centre[0] - half[0] - 0.005
-        turn = pybullet.getQuaternionFromEuler([0.0, np.pi / 2, 0.0])
-        for k, (radius, color) in enumerate(BULLSEYE):
+        for ring in bullseye_rings(half):
             disc = pybullet.createVisualShape(
-                pybullet.GEOM_CYLINDER, radius=radius, length=0.01, rgbaColor=list(color),
-                physicsClientId=self.client,
+                pybullet.GEOM_CYLINDER, radius=ring.radius, length=RING_THICKNESS,
+                rgbaColor=list(ring.color), physicsClientId=self.client,
             )  # fmt: skip
-            position = [face_x - 0.006 * k, centre[1], centre[2]]
-            pybullet.createMultiBody(0.0, -1, disc, position, turn, physicsClientId=self.client)
+            position = [centre[0] + ring.offset, centre[1], centre[2]]
+            pybullet.createMultiBody(0.0, -1, disc, position, list(RING_TURN),
+                                     physicsClientId=self.client)  # fmt: skip
 
     def update(self, positions: Sequence[Sequence[float]],
                orientations: Sequence[Sequence[float]],

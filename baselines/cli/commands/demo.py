@@ -31,15 +31,14 @@ __all__ = ["add_arguments", "run"]
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=out_dir, default=Path("runs/demo"), help="output folder")
-    parser.add_argument(
-        "--width", type=bounded_int(16, 4096), default=960, help="video width in pixels"
-    )
-    parser.add_argument(
-        "--height", type=bounded_int(16, 4096), default=540, help="video height in pixels"
-    )
+    for side, default in (("width", 960), ("height", 540)):
+        parser.add_argument(f"--{side}", type=bounded_int(16, 4096), default=default,
+                            help=f"video {side} in pixels")  # fmt: skip
     parser.add_argument(
         "--no-video", action="store_true", help="skip rendering (scorecard and plots only)"
     )
+    parser.add_argument("--no-gltf", action="store_true",
+                        help="skip three_rods.glb (the flight as glTF, for Blender or a browser)")
     parser.add_argument(
         "--paper-rule", action="store_true",
         help="end interior courses by the paper's k rules (eqs. 12-14) instead of the tangent "
@@ -55,7 +54,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     who.add_argument(
         "--compare", metavar="A,B", default=None,
         help="fly two policies (e.g. expert,minimum-jerk) and write them side by side in "
-        "compare.mp4, with both scorecards",
+        "compare.mp4, with both scorecards and both flights in compare.glb",
     )  # fmt: skip
     add_trust_argument(parser)
 
@@ -93,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         options = [
             DemoOptions(
                 out=args.out, width=args.width, height=args.height,
-                video=not args.no_video, policy=spec,
+                video=not args.no_video, gltf=not args.no_gltf, policy=spec,
                 end_rule="paper" if args.paper_rule and spec == "expert" else "tangent",
                 trust_model=trust,
             )  # fmt: skip

@@ -8,7 +8,8 @@ indices; goal times and nails), ``summary.json`` (the episode's scorecard) and t
 ``deviation.png`` (each component of D and phi against time, goal times dotted),
 ``path3d.png``, ``speed.png``, and ``figure1_vs_2.png``: dynamic constraints against
 sequential-goal constraints (the expert) on the same courses, the paper's Figures 1 and 2
-side by side. ``--video`` adds ``rollout.mp4`` (TinyRenderer frames via imageio).
+side by side. ``--video`` adds ``rollout.mp4`` (TinyRenderer frames via imageio), ``--gltf``
+``rollout.glb`` (the motion as a keyframed glTF scene, :mod:`sgc_env.export.gltf`).
 """
 
 from __future__ import annotations
@@ -43,6 +44,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_trust_argument(parser)
     parser.add_argument("--out", type=out_dir, default=None, help="output folder")
     parser.add_argument("--video", action="store_true", help="also write rollout.mp4")
+    parser.add_argument(
+        "--gltf", action="store_true",
+        help="also write rollout.glb (the motion as a keyframed glTF scene, for Blender or a "
+        "browser)",
+    )  # fmt: skip
     parser.add_argument(
         "--no-compare", action="store_true",
         help="skip the dynamic-constraints vs SGC comparison figure",
@@ -105,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
         # written next to the output folder and moved in at the end, never through a link
         with staged_output(out) as stage:
             write_rollout(stage, env, record, title, args.policy, args.seed,
-                          not args.no_compare, frames)  # fmt: skip
+                          not args.no_compare, frames, gltf=args.gltf)  # fmt: skip
     except ValueError as exc:
         return error_exit("rollout", exc)
     finally:

@@ -116,6 +116,22 @@ def test_rollout_from_env_seed_with_another_controller(tmp_path):
     assert cli.main([*argv, "--no-compare", "--out", str(out)]) == 0
     assert not (out / "figure1_vs_2.png").exists()
     assert (out / "deviation.png").is_file()
+    assert not (out / "rollout.glb").exists()  # only when asked
+
+
+def test_rollout_writes_the_motion_as_gltf_when_asked(tmp_path):
+    from tests.sgc_env.export.glb_reader import read_glb
+
+    out = tmp_path / "ro3"
+    argv = ["rollout", "--env", "SGCRod-v0", "--seed", "4", "--gltf", "--no-compare"]
+    assert cli.main([*argv, "--out", str(out)]) == 0
+    glb = read_glb(out / "rollout.glb")
+    data = np.load(out / "trajectory.npz")
+    node = glb.node_index("expert/body0")  # the random family names its one body body0
+    times, translations = glb.keyframes("expert", node, "translation")
+    np.testing.assert_allclose(times, data["time"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(translations, data["body_position"][:, 0], rtol=0, atol=1e-6)
+    assert (out / "viewer.html").is_file()
 
 
 @pytest.mark.slow

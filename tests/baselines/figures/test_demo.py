@@ -20,12 +20,13 @@ from sgc_env.paper.frames import normalized_frame
 from sgc_env.scenario.load import builtin_path
 from sgc_env.scenes import three_rods
 from sgc_env.simulator import pybullet
+from tests.sgc_env.export.glb_reader import read_glb
 
 ROD_MODEL = Path(__file__).resolve().parents[3] / "baselines/checkpoints/ppo_dagger_SGCRod-v0.zip"
 """A shipped model of the one-rod env (6 actions): it does not fit the three rods (18)."""
 OUTPUTS = {
     "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png", "goals.csv",
-    "summary.json", "rods.json",
+    "summary.json", "rods.json", "three_rods.glb", "viewer.html",
 }  # fmt: skip
 """What one run of ``sgc demo`` writes, whichever policy flies it."""
 MIN_SPEED_FRACTION = 0.1
@@ -211,6 +212,9 @@ def test_demo_compare_writes_both_runs_side_by_side(tmp_path, capsys):
     assert (out / "random" / "plates.png").exists()
     assert both[0].shape == (48, 128, 3) and expert[0].shape == (48, 64, 3)
     assert len(both) == len(expert) > len(rand)  # random ended early: its last frame is held
+    scene = read_glb(out / "compare.glb")  # both flights in one scene, an animation each
+    assert [a["name"] for a in scene.doc["animations"]] == ["expert", "random"]
+    assert (out / "viewer.html").exists() and (out / "random" / "three_rods.glb").exists()
 
     def gap(a, b):  # below the caption band, H.264 noise of a few levels
         return np.abs(a[30:].astype(int) - b[30:].astype(int)).mean()
@@ -283,7 +287,7 @@ def test_pierced_balls_ride_their_rods_and_missed_ones_fly_on():
     positions, orientations = info["body_position"], info["body_orientation"]
     before = three_rods.PIERCE_TIME - 0.5
     scene.update(before, positions, orientations)
-    balls = [base.scenario.props[k] for k in scene.ball_index]
+    balls = [base.scenario.props[k] for k in scene.carry.ball_index]
     for ball, uid in zip(balls, scene.ball_uids, strict=True):
         at = pybullet.getBasePositionAndOrientation(uid, physicsClientId=client)[0]
         np.testing.assert_allclose(at, ball.position_at(before), atol=1e-12)
