@@ -464,6 +464,8 @@ DEMOS: dict[str, Case] = {
     "npz object array payload": Case(_demos(_object_array), "holds Python objects"),
     "npz env_kwargs sim_frequency 1e7": Case(_demos(lambda tmp: _npz(
         tmp, env_kwargs=np.array('{"sim_frequency": 10000000}'))), "sim_frequency must be"),
+    "npz env_kwargs an unknown kwarg": Case(_demos(lambda tmp: _npz(
+        tmp, env_kwargs=np.array('{"no_such_kwarg": 1}'))), "does not take"),
     "npz env_kwargs nested 100k deep": Case(_demos(lambda tmp: _npz(
         tmp, env_kwargs=np.array("[" * 100_000))), "nested too deeply"),
     "npz foreign env id": Case(_demos(lambda tmp: _npz(tmp, env_id=np.array("CartPole-v1"))),

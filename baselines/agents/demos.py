@@ -35,7 +35,7 @@ import numpy as np
 from baselines.agents.pushes import Pushes, apply_random_push, push_rng
 from baselines.common.atomic_files import write_atomic
 from baselines.common.bounded_npz import limit_rows, npz_shapes
-from baselines.common.env_kwargs import check_kwarg_values
+from baselines.common.env_kwargs import check_env_kwargs
 from sgc_env import check_env_id
 from sgc_env.scenario.bounded import escaped, load_json
 
@@ -138,7 +138,7 @@ def _read_demos(path: Path, where: str) -> Demonstrations:
     _check_steps(steps, where)
     if not isinstance(env_kwargs, dict) or not isinstance(pushes, dict):
         raise ValueError(f"{where}: env_kwargs and pushes must be JSON objects")
-    check_kwarg_values(env_kwargs, f"{where}: env_kwargs")
+    env_kwargs = check_env_kwargs(env_id, env_kwargs, f"{where}: env_kwargs")
     return Demonstrations(**steps, seeds=seeds, env_id=env_id, env_kwargs=env_kwargs,
                           pushes=Pushes(**pushes))  # fmt: skip
 
