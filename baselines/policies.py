@@ -12,9 +12,10 @@ then). Model files are loaded without unpickling anything (:mod:`baselines.model
 unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model trained
 behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
 (:func:`vecnormalize_path`, :mod:`baselines.models.normalization`), so it sees the observations it
-was trained on. The expert and the comparison controllers read the planner's view; on an env
-that observes another (the newest ids' learner's view) they act on the env's planner view of
-its current state (:mod:`baselines.common.planner_view`). Every policy has the SB3 signature
+was trained on. The expert and the comparison controllers read the planner's view; built on an
+env that observes another (the newest ids' learner's view) they act on the env's planner view
+of its current state themselves (:mod:`baselines.common.planner_view`). Every policy has the
+SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.
 """
 
@@ -29,7 +30,7 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
-from baselines.common.planner_view import OnPlannerView, observed_view
+from baselines.common.planner_view import planner_reader
 from baselines.common.shipped import resolve_policy_spec
 from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
@@ -113,7 +114,8 @@ class EpisodeExpert:
     The expert reads masses, inertias and force limits once, at construction; a scenario
     swapped through ``reset(options={"scenario": ...})`` can change them, and a stale model
     under- or over-drives the body. This wrapper keeps one expert per sub-env and rebuilds it
-    when an episode starts (``episode_start`` or an observation at tick 0).
+    when an episode starts (``episode_start`` or an observation at tick 0). On an env of
+    another view it acts on the env's planner view of its current state, as the expert does.
     """
 
     def __init__(self, env: Any, end_rule: str | None = None) -> None:
@@ -122,6 +124,7 @@ class EpisodeExpert:
         self.end_rule = end_rule
         self._probe = episode_model(env, 0)
         self._experts: dict[int, SGCExpert] = {}
+        self._planner = planner_reader(env, "EpisodeExpert")  # None: the planner's view
 
     def predict(
         self,
@@ -130,6 +133,9 @@ class EpisodeExpert:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
+        if self._planner is not None:
+            observation = self._planner.read(observation)
+
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
                 model = episode_model(self.env, i)
@@ -224,10 +230,11 @@ def _needs_flat_observation(env: Any, spec: str) -> None:
 
 def needs_planner_view(spec: str) -> bool:
     """Whether the policy ``spec`` names reads the planner's view (the expert and the
-    comparison controllers). On an env of another view :func:`make_policy` has it read the
-    env's own planner view of its current state
-    (:class:`~baselines.common.planner_view.OnPlannerView`); the harness makes its env with
-    ``observation="planner"`` instead, the same scenes and dynamics on any version of an id."""
+    comparison controllers). On an env of another view such a policy reads the env's own
+    planner view of its current state (:func:`~baselines.common.planner_view.planner_reader`);
+    the harness makes its env with ``observation="planner"`` instead, the same scenes and
+    dynamics on any version of an id, where the batched env's fast path need not hand out its
+    sub-envs every step."""
     builtin = POLICY_FACTORIES.get(resolve_policy_spec(spec)) if isinstance(spec, str) else None
     return builtin is not None and builtin.flat
 
@@ -300,8 +307,7 @@ def make_policy(
         if not builtin.flat:
             return builtin.make(env, seed)
         _needs_flat_observation(env, spec)
-        policy = builtin.make(env, seed)
-        return policy if observed_view(env) == "planner" else OnPlannerView(policy, env)
+        return builtin.make(env, seed)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
         trust = _TRUST_MODELS.get() if trust_model is None else trust_model
         single = _spaces_env(env)

@@ -9,7 +9,6 @@ import pytest
 
 import sgc_env
 from baselines import SGCExpert
-from baselines.common.planner_view import OnPlannerView
 from baselines.evaluation.harness import evaluate
 from baselines.policies import make_policy, needs_planner_view
 
@@ -37,15 +36,19 @@ def test_the_expert_is_exact_on_the_newest_versions(env_id: str) -> None:
     assert np.isnan(orientation) or orientation < 1e-9
 
 
-def test_the_expert_says_which_view_it_reads() -> None:
-    """By hand on the learner's view the expert refuses; make_policy has it read the env's
-    planner view (tests/baselines/common/test_planner_view.py)."""
+def test_the_expert_reads_the_planner_view_itself() -> None:
+    """By hand, as make_policy builds it, the expert on the learner's view acts on the env's
+    planner view (tests/baselines/controllers/test_expert.py); the harness needs it."""
     env = gym.make("SGCRod-v1")
-    with pytest.raises(ValueError, match="planner's view.*observation='planner'"):
-        SGCExpert(env)
-    assert isinstance(make_policy("expert", env), OnPlannerView)
+    obs, _ = env.reset(seed=0)
+    by_hand, _ = SGCExpert(env).predict(obs)
+    planner = gym.make("SGCRod-v1", observation="planner")
+    theirs, _ = planner.reset(seed=0)
+    assert np.array_equal(by_hand, SGCExpert(planner).predict(theirs)[0])
+    assert np.array_equal(make_policy("expert", env).predict(obs)[0], by_hand)
     assert needs_planner_view("expert") and not needs_planner_view("random")
     env.close()
+    planner.close()
 
 
 def test_same_scenes_and_dynamics_as_the_planner_version() -> None:

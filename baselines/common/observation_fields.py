@@ -11,29 +11,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from baselines.common.planner_view import observed_view
 from sgc_env.observation import ObservationLayout
 
-__all__ = [
-    "COURSE_SIZE", "BodyFields", "BodyObservation", "TrackFields", "read_body",
-    "require_planner_view",
-]  # fmt: skip
-
-
-def require_planner_view(env: Any, reader: str) -> None:
-    """A ValueError unless ``env`` (or a vector env's first reachable sub-env) observes the
-    planner's view, the one this module decodes; ``reader`` names who needs it."""
-    view = observed_view(env)
-    if view != "planner":
-        raise ValueError(
-            f"{reader} reads the planner's view; this env observes the {view!r} view: make it "
-            "with gym.make(id, observation='planner'), or make the policy with "
-            "baselines.policies.make_policy, which reads the env's planner_observation()"
-        )
+__all__ = ["COURSE_SIZE", "BodyFields", "BodyObservation", "TrackFields", "read_body"]
 
 
 _COURSE_FIELDS = ("course_start", "course_duration", "next_start", "next_duration",

@@ -2,7 +2,8 @@
 
 SB3's ``DummyVecEnv`` and Gymnasium's ``SyncVectorEnv`` hold their sub-envs in ``.envs``;
 ``SubprocVecEnv`` and ``AsyncVectorEnv`` keep them in other processes, where only
-``get_attr`` reaches them. Both kinds (and plain or wrapped envs) go through :func:`sub_env`.
+``get_attr`` reaches them. Both kinds (and plain or wrapped envs) go through :func:`sub_env`;
+Gymnasium's vector wrappers forward neither, so they are looked through (:func:`vector_base`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from typing import Any
 
 import gymnasium as gym
 
-__all__ = ["MODEL_ATTRIBUTES", "base_env", "is_vector", "sub_env"]
+__all__ = ["MODEL_ATTRIBUTES", "base_env", "is_vector", "sub_env", "vector_base"]
 
 MODEL_ATTRIBUTES = (
     "scenario",
@@ -37,6 +38,13 @@ def is_vector(env: Any) -> bool:
     return vec_env is not None and isinstance(env, vec_env.VecEnv)
 
 
+def vector_base(env: Any) -> Any:
+    """A Gymnasium vector env under its vector wrappers (``RecordEpisodeStatistics``, ...),
+    whose ``envs``, ``call`` and ``get_attr`` they do not forward; any other env as it is
+    (SB3's ``VecEnvWrapper`` forwards them itself)."""
+    return env.unwrapped if isinstance(env, gym.vector.VectorEnv) else env
+
+
 def _get_attr(env: Any, name: str, index: int) -> Any:
     try:  # SB3: get_attr(name, indices)
         return env.get_attr(name, [index])[0]
@@ -52,6 +60,7 @@ def sub_env(env: Any, index: int = 0) -> Any:
     """
     if not is_vector(env):
         return env
+    env = vector_base(env)
     envs = getattr(env, "envs", None)
     if envs is not None:
         return envs[index]

@@ -11,7 +11,11 @@ same deadbeat actuation as :class:`~baselines.controllers.expert.SGCExpert`, so 
   the same times, built from the env's resolved scenario at each episode start.
 
 Both keep a little per-episode state (one slot per sub-env of a vector env) and reset it at
-``episode_start`` or whenever the observation's time is back at tick 0.
+``episode_start`` or whenever the observation's time is back at tick 0. On an env that
+observes another view than the planner's (the newest ids' learner's view) they act, as the
+expert does, on the env's planner view of its current state
+(:func:`~baselines.common.planner_view.planner_reader`): ``predict`` must then be handed the
+observation that env just returned.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from scipy.spatial.transform import Rotation
 
 from baselines.common.env_model import EnvModel
 from baselines.common.observation_fields import BodyObservation, read_body
+from baselines.common.planner_view import planner_reader
 from baselines.common.sub_envs import base_env, sub_env
 from baselines.controllers.actuation import wrench_for_targets
 from baselines.controllers.dynamic_constraints import DynamicConstraintsCourse, choose_tau
@@ -102,6 +107,7 @@ class _StatefulPolicy:
     def __init__(self, env: Any) -> None:
         self.env = env
         self.model = EnvModel.from_env(env)
+        self._planner = planner_reader(env, type(self).__name__)  # None: the planner's view
         self._slots: dict[int, Any] = {}
         self._models: dict[int, EnvModel] = {}
         self._last_tick: dict[int, int] = {}
@@ -113,7 +119,10 @@ class _StatefulPolicy:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """Action(s) for one flat observation or a batch; ``state`` is passed through."""
+        """Action(s) for one flat observation or a batch; ``state`` is passed through. On an
+        env of another view the observation must be the one the env last returned."""
+        if self._planner is not None:
+            observation = self._planner.read(observation)
         return predict_per_env(observation, episode_start, self._row_action), state
 
     def _row_action(self, index: int, observation: np.ndarray, episode_start: bool) -> np.ndarray:

@@ -8,8 +8,12 @@ the plan's next sample, through the known PyBullet integrator
 itself, so goals are met to floating point. A push mid-course simply becomes a new measured state to
 re-plan from.
 
-The policy reads only the observation (plus the env's constants in :class:`EnvModel`), so it
-runs inside ``evaluate_policy``, vector envs and imitation tools.
+On an env of the planner's view the policy reads only the observation (plus the env's
+constants in :class:`EnvModel`), so it runs inside ``evaluate_policy``, vector envs and
+imitation tools, offline observations included. Built on an env of another view (the newest
+ids' learner's view) it acts on the env's planner view of its current state
+(:func:`~baselines.common.planner_view.planner_reader`): it must then be asked about the
+observation that env just returned, which it checks.
 """
 
 from __future__ import annotations
@@ -21,12 +25,8 @@ from typing import Any
 import numpy as np
 
 from baselines.common.env_model import BodyModel, EnvModel
-from baselines.common.observation_fields import (
-    COURSE_SIZE,
-    BodyFields,
-    TrackFields,
-    require_planner_view,
-)
+from baselines.common.observation_fields import COURSE_SIZE, BodyFields, TrackFields
+from baselines.common.planner_view import PlannerReader, planner_reader
 from baselines.common.sub_envs import base_env
 from baselines.controllers.actuation import body_wrench
 from baselines.controllers.matched_table import (
@@ -57,7 +57,10 @@ class SGCExpert:
 
     Build it from the environment it will drive (``SGCExpert(env)``, wrapped or vectorised
     envs too): it needs the bodies' masses, inertias and action limits, which are constants of
-    the env rather than observations.
+    the env rather than observations. On an env that observes another view than the
+    planner's, ``predict`` reads the planner's view of that env's current state and must be
+    handed the observation the env just returned (a ValueError otherwise:
+    :class:`~baselines.common.planner_view.PlannerReader`); goals stay exact.
     """
 
     def __init__(
@@ -94,7 +97,6 @@ class SGCExpert:
         if model is None:
             if env is None:
                 raise ValueError("SGCExpert needs an env or an EnvModel")
-            require_planner_view(env, "SGCExpert")
             model = EnvModel.from_env(env)
         if end_rule is not None and end_rule not in EXPERT_RULES:
             raise ValueError(f"end_rule must be one of {list(EXPERT_RULES)}, got {end_rule!r}")
@@ -102,6 +104,9 @@ class SGCExpert:
             raise ValueError(f"end_rule={end_rule!r} needs the env or the episode's scenario")
         self.model = model
         self._env = env
+        self._planner: PlannerReader | None = None
+        if env is not None:  # None on the planner's view: the observation is read as it is
+            self._planner = planner_reader(env, "SGCExpert")
         self._scenario = scenario
         self._table: MatchedTable | None = None
         self.refine = refine
@@ -121,9 +126,12 @@ class SGCExpert:
         """Action(s) for one observation or a batch of them; the state is passed through.
 
         A goal-conditioned (Dict) observation is read through its ``observation`` entry, which
-        holds the flat observation.
+        holds the flat observation. On an env of another view the observation must be the one
+        the env last returned: the action is that for the env's planner view of it.
         """
-        if isinstance(observation, dict):
+        if self._planner is not None:
+            observation = self._planner.read(observation)
+        elif isinstance(observation, dict):
             observation = observation["observation"]
         obs = np.asarray(observation)
         if obs.ndim == 1:
@@ -131,7 +139,8 @@ class SGCExpert:
         return np.stack([self.action(o) for o in obs]), state
 
     def action(self, observation: np.ndarray) -> np.ndarray:
-        """Normalised action for one flat observation.
+        """Normalised action for one flat observation of the planner's view (as it is: on an
+        env of another view :meth:`predict` reads the env's planner view first).
 
         The observation is read once into Python floats (``float32`` value plus its
         ``_residual``, in double precision) and the whole step runs in plain floats.

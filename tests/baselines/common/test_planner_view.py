@@ -11,7 +11,12 @@ import pytest
 
 import sgc_env  # noqa: F401  (registers the ids)
 from baselines import SGCExpert
-from baselines.common.planner_view import OnPlannerView, observed_view, planner_observation
+from baselines.common.planner_view import (
+    OnPlannerView,
+    last_observation,
+    observed_view,
+    planner_observation,
+)
 from baselines.policies import make_policy
 
 
@@ -86,20 +91,22 @@ def test_vector_envs_in_and_out_of_process_hand_out_planner_rows(kind: str) -> N
     pytest.importorskip("stable_baselines3")
     vec = _vector(kind)
     if isinstance(vec, gym.vector.VectorEnv):
-        vec.reset(seed=5)
+        observations, _ = vec.reset(seed=5)
     else:
         vec.seed(5)
-        vec.reset()
+        observations = vec.reset()
     rows = planner_observation(vec)
     single = gym.make("SGCRod-v1", observation="planner")
     assert rows.shape == (2, single.observation_space.shape[0])
     for i in range(2):
         assert np.array_equal(rows[i], single.reset(seed=5 + i)[0])
     assert observed_view(vec) == "learner"
+    assert np.array_equal(last_observation(vec), observations)
     policy = make_policy("expert", vec)  # the view is read across processes too
-    assert isinstance(policy, OnPlannerView)
     reference = make_policy("expert", gym.make("SGCRod-v1", observation="planner"))
-    assert np.array_equal(policy.predict(np.zeros((2, 50)))[0], reference.predict(rows)[0])
+    assert np.array_equal(policy.predict(observations)[0], reference.predict(rows)[0])
+    with pytest.raises(ValueError, match="not the one its env last returned"):
+        policy.predict(observations[::-1])  # the sub-envs' rows swapped
     vec.close()
 
 
@@ -108,9 +115,7 @@ def test_make_policy_puts_the_expert_on_the_planner_view() -> None:
     planner's version, every goal met exactly; a stray observation shape is refused."""
     learner, planner = gym.make("SGCRod-v1"), gym.make("SGCRod-v1", observation="planner")
     policy = make_policy("expert", learner)
-    assert isinstance(policy, OnPlannerView)
     reference = make_policy("expert", planner)
-    assert not isinstance(reference, OnPlannerView)
     obs, _ = learner.reset(seed=2)
     theirs, _ = planner.reset(seed=2)
     errors = []
@@ -126,7 +131,20 @@ def test_make_policy_puts_the_expert_on_the_planner_view() -> None:
     assert errors and max(errors) < 1e-9
     with pytest.raises(ValueError, match="shape"):
         policy.predict(theirs)  # the planner's observation handed to the learner's env's policy
-    with pytest.raises(ValueError, match="planner_observation"):
-        SGCExpert(learner)  # built by hand on the learner's view: the error says how instead
+    learner.close()
+    planner.close()
+
+
+def test_on_planner_view_puts_an_observation_only_policy_on_the_learner_view() -> None:
+    """``SGCExpert(model=...)`` reads observations only: OnPlannerView hands it the env's
+    planner view, under the same check of the observation as the expert's own."""
+    learner, planner = gym.make("SGCRod-v1"), gym.make("SGCRod-v1", observation="planner")
+    obs, _ = learner.reset(seed=2)
+    theirs, _ = planner.reset(seed=2)
+    policy = OnPlannerView(SGCExpert(model=SGCExpert(planner).model), learner)
+    assert np.array_equal(policy.predict(obs)[0], SGCExpert(planner).predict(theirs)[0])
+    learner.step(policy.predict(obs)[0])
+    with pytest.raises(ValueError, match="not the one its env last returned"):
+        policy.predict(obs)  # stale: the env has stepped since
     learner.close()
     planner.close()
