@@ -108,7 +108,8 @@ def fixed_env(env_id: str) -> tuple[SGCEnv, SGCEnv]:
     """
     made = gym.make(env_id).unwrapped
     made.reset(seed=0)
-    fixed = SGCEnv(made.scenario)
+    view = {k: v for k, v in gym.spec(env_id).kwargs.items() if k in ("observation", "reward")}
+    fixed = SGCEnv(made.scenario, **view)  # the id's view and reward: they cost per step
     fixed.reset()
     return made, fixed
 

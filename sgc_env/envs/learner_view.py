@@ -33,12 +33,16 @@ single env (one row) and the batched env (N rows) share this one function.
 
 from __future__ import annotations
 
+import functools
+import operator
+from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
+from sgc_env.paper.elementwise import where
 
 from .views import ObservationView, observation_view
 
@@ -60,33 +64,36 @@ TIME_LOW, TIME_HIGH = -1.0, 3.0
 LEARNER_TRACK_SIZE = 6 * 3 + 1 + 2 + 2
 LEARNER_BODY_SIZE = 2 * LEARNER_TRACK_SIZE + 3
 
+Vec = Sequence[Any]  # components: floats for one env, arrays for the batch
+
 _L = ObservationLayout(1)
 
 
-def _cols(name: str) -> slice:
-    return _L.body_slice(0, name)
+def _start(name: str) -> int:
+    return _L.body_slice(0, name).start
 
 
-def _gather(*fields: str) -> np.ndarray:
-    """Block columns of ``fields`` (position track's then orientation track's), (2, columns)."""
-    out = []
+# Per track, the block columns its rule reads (component columns consecutive): the deviation,
+# its rate, the time left, then the course entries, course start to flags (one run of columns).
+_TRACK_COLUMNS = tuple(
+    (_start(deviation), _start(rate), _start(f"{track}_time_left"),
+     _start(f"{track}_course_start"))
     for track, deviation, rate in (
         ("position", "position_deviation", "point_velocity"),
         ("orientation", "orientation_deviation", "angular_velocity"),
-    ):
-        names = [f.format(track=track, deviation=deviation, rate=rate) for f in fields]
-        out.append(np.concatenate([np.r_[_cols(name)] for name in names]))
-    return np.array(out)
-
-
-# The columns both tracks read, gathered by one fancy index each (N, bodies, 2, width): the
-# view costs numpy's per-call overhead, so the two tracks share every call.
-_VECTORS = _gather(
-    "{deviation}", "{rate}", "{track}_course_start", "{track}_next_start", "{track}_end_velocity"
+    )
+)  # fmt: skip
+# course start, duration, next start, next duration, end velocity, flags
+_COURSE_SIZE = 3 + 1 + 3 + 1 + 3 + 2
+# The same columns as one fancy index for the batch, (2 tracks, 20): D, D', t, then the course.
+_BATCH_COLUMNS = np.array(
+    [
+        [*range(d, d + 3), *range(r, r + 3), t, *range(c, c + _COURSE_SIZE)]
+        for d, r, t, c in _TRACK_COLUMNS
+    ]
 )
-_SCALARS = _gather("{track}_time_left", "{track}_course_duration", "{track}_next_duration")
-_FLAGS = _gather("{track}_flags")
 _SCALES = np.array([ERROR_SCALE] * 3 + [RATE_SCALE] * 3 + [VELOCITY_SCALE] * 6 + [GOAL_SCALE] * 6)
+_RAW = len(_SCALES)  # squashed entries per track
 
 
 def learner_size(n_bodies: int) -> int:
@@ -106,46 +113,117 @@ def learner_bounds(n_bodies: int) -> tuple[np.ndarray, np.ndarray]:
     return low, high
 
 
-def _squash(x: np.ndarray) -> np.ndarray:
-    return SQUASH * np.tanh(x / SQUASH)
+def _clip(x: Any, low: float, high: float) -> Any:
+    """``np.clip``'s values (NaN stays NaN; at a bound, the bound, as ``np.maximum`` and
+    ``np.minimum`` give it) on an array, or on a float in plain Python."""
+    if x.__class__ is np.ndarray:
+        return np.minimum(np.maximum(x, low), high)
+    x = low if x <= low else x
+    return high if x >= high else x
 
 
-def _clip(x: np.ndarray, low: float, high: float) -> np.ndarray:
-    """``np.clip``'s values (NaN stays NaN) at a third of its call overhead on small arrays."""
-    return np.minimum(np.maximum(x, low), high)
+def _pick(condition: Any, a: list[Any], b: list[Any]) -> list[Any]:
+    """:func:`~sgc_env.paper.elementwise.where` of each component: one branch for a float
+    condition, one ``np.where`` per component for an array."""
+    if condition.__class__ is np.ndarray:
+        return [np.where(condition, x, y) for x, y in zip(a, b, strict=True)]
+    return a if condition else b
 
 
-def _tracks(block: np.ndarray) -> np.ndarray:
-    """The 23 entries of both tracks of every (row, body) of ``block`` (N, bodies, block):
-    (N, bodies, 2, 23), position track first."""
-    vectors = block[..., _VECTORS].reshape(*block.shape[:-1], 2, 5, 3)
-    d, r, c0, c1, v_end = (vectors[..., k, :] for k in range(5))
-    scalars = block[..., _SCALARS]
-    t, span, next_span = scalars[..., 0], scalars[..., 1], scalars[..., 2]
-    flag = block[..., _FLAGS]
-    has = flag[..., 0:1]
-    in_course = ((t >= 0.0) & (span > 0.0))[..., None]
-    safe_span = np.where(span > 0.0, span, 1.0)[..., None]
-    fraction = t[..., None] / safe_span
-    schedule = np.where(in_course, c0 * fraction, -v_end * t[..., None])
-    schedule_rate = np.where(in_course, -c0 / safe_span, v_end)
-    has_next = (next_span > 0.0)[..., None]
-    next_rate = np.where(has_next, -c1 / np.where(has_next, next_span[..., None], 1.0), 0.0)
-    next_goal = np.where(has_next, -(d + c1), 0.0)
-    next_time = np.where(has_next[..., 0], t + next_span, 0.0)
-    raw = np.concatenate(
-        (d - schedule, r - schedule_rate, schedule_rate, next_rate, -d, next_goal), axis=-1
-    )
-    times = np.stack((t, next_time), axis=-1)
-    return np.concatenate(
-        (
-            has * _squash(raw / _SCALES),
-            has * np.where(in_course, _clip(fraction, 0.0, 1.0), 0.0),
-            has * _clip(times, TIME_LOW, TIME_HIGH),
-            flag,
-        ),
-        axis=-1,
-    )
+def _track(
+    d: Vec, r: Vec, t: Any, c0: Vec, span: Any, c1: Vec, next_span: Any, v_end: Vec, has: Any,
+    last: Any,
+) -> tuple[list[Any], list[Any]]:  # fmt: skip
+    """One track's rule (module table): its 18 entries before the squash (``D - D_sched``,
+    ``D' - D'_sched``, ``D'_sched``, the next course's ``D'_sched``, the goal and the next
+    goal relative to the body) and its last 5 (time fraction, times, flags).
+
+    Written once for one env and for many (:mod:`sgc_env.paper.elementwise`): a vector is its
+    3 components as floats (one track of one env) or one array whose last axis holds them (all
+    tracks of all sub-envs, the scalars' last axis of size 1), so the batch makes the calls of
+    one track. The course: its start ``c0`` and duration, the next course's start ``c1`` and
+    duration, the end velocity and the flags. Past the course's end (``t < 0``) the schedule
+    runs on at the end velocity.
+    """
+    in_course = (t >= 0.0) & (span > 0.0)
+    safe = where(span > 0.0, span, 1.0)
+    fraction = t / safe
+    schedule = _pick(in_course, [x * fraction for x in c0], [-x * t for x in v_end])
+    rate = _pick(in_course, [-x / safe for x in c0], list(v_end))
+    has_next = next_span > 0.0
+    zero = [0.0] * len(d)
+    next_safe = where(has_next, next_span, 1.0)
+    next_rate = _pick(has_next, [-x / next_safe for x in c1], zero)
+    next_goal = _pick(has_next, [-(x + y) for x, y in zip(d, c1, strict=True)], zero)
+    raw = [
+        *map(operator.sub, d, schedule), *map(operator.sub, r, rate), *rate, *next_rate,
+        *map(operator.neg, d), *next_goal,
+    ]  # fmt: skip
+    tail = [
+        has * where(in_course, _clip(fraction, 0.0, 1.0), 0.0),
+        has * _clip(t, TIME_LOW, TIME_HIGH),
+        has * _clip(where(has_next, t + next_span, 0.0), TIME_LOW, TIME_HIGH),
+        has,
+        last,
+    ]
+    return raw, tail
+
+
+def _squash(raw: np.ndarray, has: np.ndarray | None) -> np.ndarray:
+    """``has * c tanh(x / c)`` of the scaled raw entries (..., 18), in place: the one
+    transcendental, numpy's for one env and for many (its tanh may differ from libm's in the
+    last bit). ``has`` None: every track is on (``1 * x`` is ``x``, bit for bit)."""
+    raw /= _SCALES
+    raw /= SQUASH
+    np.tanh(raw, out=raw)
+    raw *= SQUASH
+    if has is not None:
+        raw *= has
+    return raw
+
+
+@functools.cache
+def _order(n_bodies: int) -> np.ndarray:
+    """Where each entry of one env's view sits in the list :func:`_observe_one` builds (the
+    squashed entries of every track, the tracks' flags ``has``, then the rest in view order)."""
+    squashed = 2 * n_bodies * _RAW
+    tail = squashed + 2 * n_bodies
+    order: list[int] = []
+    for j in range(n_bodies):
+        for k in (2 * j, 2 * j + 1):
+            order += range(k * _RAW, (k + 1) * _RAW)
+            order += range(tail + 5 * k, tail + 5 * k + 5)
+        order += range(tail + 10 * n_bodies + 3 * j, tail + 10 * n_bodies + 3 * j + 3)
+    order.append(tail + 13 * n_bodies)
+    return np.array(order)
+
+
+def _observe_one(record: list[float], constants: list[float], n_bodies: int) -> np.ndarray:
+    """One env's view from its record and constants as floats: the rule on floats, one track
+    at a time (numpy's per-call overhead dwarfs a few bodies' arithmetic), and the squash on
+    one array."""
+    raw: list[float] = []
+    flags: list[float] = []
+    tails: list[float] = []
+    for j in range(n_bodies):
+        o = j * BODY_BLOCK_SIZE
+        for d, r, t, c in _TRACK_COLUMNS:
+            d, r, t, c = d + o, r + o, t + o, c + o
+            entries, tail = _track(
+                record[d : d + 3], record[r : r + 3], record[t], record[c : c + 3],
+                record[c + 3], record[c + 4 : c + 7], record[c + 7], record[c + 8 : c + 11],
+                record[c + 11], record[c + 12],
+            )  # fmt: skip
+            raw += entries
+            flags.append(tail[3])
+            tails += tail
+    tails += [_clip(h, -1.0, 1.0) for h in constants[:-1]]
+    tails.append(_clip(record[n_bodies * BODY_BLOCK_SIZE] * constants[-1], 0.0, 1.0))
+    values = np.fromiter(raw + flags + tails, np.float64)
+    size = len(raw)
+    has = None if flags.count(1.0) == len(flags) else values[size : size + len(flags), None]
+    _squash(values[:size].reshape(-1, _RAW), has)
+    return values[_order(n_bodies)].astype(np.float32)
 
 
 def learner_observation(
@@ -155,12 +233,19 @@ def learner_observation(
 
     ``block``: the planner's record (N, bodies, block) in float64; ``hover``: the hovering
     action of every body (N, bodies, 3); ``episode_fraction``: elapsed steps over the
-    episode's steps (N,).
+    episode's steps (N,). The rule runs once on arrays over (N, bodies, 2 tracks).
     """
     if block.ndim != 3 or block.shape[-1] != BODY_BLOCK_SIZE:
         raise ValueError(f"learner_observation: expected (N, bodies, {BODY_BLOCK_SIZE}) record")
     n, b = block.shape[:2]
-    tracks = _tracks(block).reshape(n, b, 2 * LEARNER_TRACK_SIZE)
+    g = block[..., _BATCH_COLUMNS]  # (N, bodies, 2, 20)
+    has = g[..., 18:19]
+    raw, tail = _track(
+        [g[..., 0:3]], [g[..., 3:6]], g[..., 6:7], [g[..., 7:10]], g[..., 10:11],
+        [g[..., 11:14]], g[..., 14:15], [g[..., 15:18]], has, g[..., 19:20],
+    )  # fmt: skip
+    squashed = _squash(np.concatenate(raw, axis=-1), has)
+    tracks = np.concatenate((squashed, *tail), axis=-1).reshape(n, b, -1)
     bodies = np.concatenate((tracks, _clip(hover, -1.0, 1.0)), axis=-1).reshape(n, -1)
     fraction = _clip(episode_fraction, 0.0, 1.0).reshape(n, 1)
     return np.concatenate((bodies, fraction), axis=-1).astype(np.float32)
@@ -188,6 +273,8 @@ class LearnerView(ObservationView):
     def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
         n_bodies = self.layout.n_bodies
         size = self.layout.size
+        if record.ndim == 1 and constants is not None and constants.size:  # one env's step
+            return _observe_one(record[:size].tolist(), constants.tolist(), n_bodies)
         rows = record.reshape(-1, record.shape[-1])
         block = rows[:, : size - 1].reshape(len(rows), n_bodies, BODY_BLOCK_SIZE)
         if constants is None or constants.size == 0:
