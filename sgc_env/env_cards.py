@@ -103,7 +103,7 @@ def _learner_version(old: str, goal: bool = False) -> str:
         f"for bit. `{old}` keeps the planner's view and its reward: the benchmark's "
         "leaderboards, the shipped models and the scorecard use it. The exact expert reads the "
         "planner's view; on this version it reads `env.unwrapped.planner_observation()`, the "
-        "planner's view of the same state (`make_policy(\"expert\", env)` does so), so "
+        "planner's view of the same state (`SGCExpert(env)` does so itself), so "
         "demonstrations, BC and DAgger store and train on the learner's view."
     )
 
@@ -316,7 +316,7 @@ LEARNER_NOTE = (
     "0.4 of a unit of 0.05 m), bounded when a body is far off it, so a network is never handed "
     "inputs of 20-100. No absolute positions and no float32 precision residuals: a policy that "
     "must be exact (the expert) reads the planner's view of the same state, "
-    "`env.unwrapped.planner_observation()` (`make_policy(\"expert\", env)` does so). Entries "
+    "`env.unwrapped.planner_observation()` (`SGCExpert(env)` does so itself). Entries "
     "of a track the body does not have are 0, as are the next-goal entries on the last goal."
 )
 
