@@ -1,5 +1,7 @@
 """Control steps per second of every registered env against a bare PyBullet loop.
 
+Every id of ``sgc_env.ENV_IDS`` and ``sgc_env.LEARNER_IDS``, each on its own view and reward.
+
 The bare loop does the same physics in the same process: the same bodies and props, the same
 number of substeps, the same applyExternalForce/Torque (and prop placement) calls per substep,
 and one getBasePositionAndOrientation + getBaseVelocity per body per control step. Reset time is
@@ -124,14 +126,15 @@ def main() -> None:
         help="random-scene resets timed per id",
     )  # fmt: skip
     args = parser.parse_args()
-    width = max(len(env_id) for env_id in sgc_env.ENV_IDS)
+    ids = (*sgc_env.ENV_IDS, *sgc_env.LEARNER_IDS)
+    width = max(len(env_id) for env_id in ids)
     header = (
         f"{'id':{width}} {'env steps/s':>12} {'bare steps/s':>13} {'ratio':>6} "
         f"{'reset us':>9} {'draw+reset us':>14}"
     )
     print(header)
     print("-" * len(header))
-    for env_id in sgc_env.ENV_IDS:
+    for env_id in ids:
         made, fixed = fixed_env(env_id)
         bare = BareLoop(fixed)
         action = hover_action(fixed)
