@@ -71,14 +71,14 @@ def planner_observation(env: Any) -> np.ndarray:
 def last_observation(env: Any) -> np.ndarray:
     """The flat observation ``env`` last handed out (by ``reset``, ``step``, ``apply_impulse``
     or ``restore_state``; a goal env's ``observation`` entry), in its own view: (size,), or
-    (N, size) for a vector env. ``SGCEnv`` keeps it as ``_obs``, which the batched env keeps
-    up to date in its sub-envs."""
+    (N, size) for a vector env (``SGCEnv.last_observation``, which the batched env keeps up
+    to date in its sub-envs)."""
     if not is_vector(env):
-        return _base(env)._obs
+        return _base(env).last_observation
     bases = _in_process(env)
     if bases is not None:
-        return np.stack([base._obs for base in bases])
-    return np.stack(vector_base(env).get_attr("_obs"))  # behind processes: SB3's, Gymnasium's
+        return np.stack([base.last_observation for base in bases])
+    return np.stack(vector_base(env).get_attr("last_observation"))  # behind processes
 
 
 def _flat(observation: Any) -> np.ndarray:

@@ -338,6 +338,13 @@ class SGCEnv(gym.Env):
         """The planner's view of the current state under any ``observation`` (the expert's)."""
         return self._planner_view.observe(np.append(self._block, self._tick * self.dt))
 
+    @property
+    def last_observation(self) -> np.ndarray:
+        """The flat observation last handed out (by ``reset``, ``step``, ``apply_impulse`` or
+        ``restore_state``), in this env's view: what a planner policy checks it was asked
+        about before it reads :meth:`planner_observation`."""
+        return self._obs
+
     # ---------------------------------------------------------------- reset / step
 
     def reset(  # type: ignore[override]  # StepInfo is a TypedDict, at runtime the dict promised
