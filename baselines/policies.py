@@ -30,7 +30,7 @@ from typing import Any, NamedTuple, Protocol, runtime_checkable
 import gymnasium as gym
 import numpy as np
 
-from baselines.common.planner_view import planner_reader
+from baselines.common.planner_view import planner_input, planner_reader
 from baselines.common.shipped import resolve_policy_spec
 from baselines.controllers.comparison_policies import (
     DynamicConstraintsController,
@@ -133,8 +133,7 @@ class EpisodeExpert:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        if self._planner is not None:
-            observation = self._planner.read(observation)
+        observation = planner_input(self._planner, observation)
 
         def row_action(i: int, row: np.ndarray, start: bool) -> np.ndarray:
             if start or i not in self._experts or observation_tick(self._probe, row) == 0:
@@ -220,14 +219,6 @@ def _with_saved_normalization(model: Any, path: str | Path, env: Any, trust: boo
     return NormalizedPolicy(model, load_statistics(stats, env, trust_model=trust))
 
 
-def _needs_flat_observation(env: Any, spec: str) -> None:
-    if not isinstance(env.observation_space, gym.spaces.Box):
-        raise ValueError(
-            f"policy {spec!r} reads the flat SGC observation; this env's observation space is "
-            f"{type(env.observation_space).__name__}"
-        )
-
-
 def needs_planner_view(spec: str) -> bool:
     """Whether the policy ``spec`` names reads the planner's view (the expert and the
     comparison controllers). On an env of another view such a policy reads the env's own
@@ -304,9 +295,6 @@ def make_policy(
     spec = resolve_policy_spec(spec)
     builtin = POLICY_FACTORIES.get(spec)
     if builtin is not None:
-        if not builtin.flat:
-            return builtin.make(env, seed)
-        _needs_flat_observation(env, spec)
         return builtin.make(env, seed)
     if spec.endswith(".zip") or Path(spec).suffix == ".zip" or Path(spec).exists():
         trust = _TRUST_MODELS.get() if trust_model is None else trust_model

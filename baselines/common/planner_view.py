@@ -27,6 +27,7 @@ __all__ = [
     "PlannerReader",
     "last_observation",
     "observed_view",
+    "planner_input",
     "planner_observation",
     "planner_reader",
 ]
@@ -144,6 +145,13 @@ class PlannerReader:
                 "on an env made with gym.make(id, observation='planner')"
             )
         return planner_observation(self.env)
+
+
+def planner_input(planner: PlannerReader | None, observation: Any) -> np.ndarray:
+    """What a planner policy acts on: the planner's view read by ``planner`` (an env of
+    another view), else the flat observation it was handed (a goal env's Dict read through its
+    ``observation`` entry)."""
+    return _flat(observation) if planner is None else planner.read(observation)
 
 
 def planner_reader(env: Any, reader: str) -> PlannerReader | None:

@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation
 
 from baselines.common.env_model import EnvModel
 from baselines.common.observation_fields import BodyObservation, read_body
-from baselines.common.planner_view import planner_reader
+from baselines.common.planner_view import planner_input, planner_reader
 from baselines.common.sub_envs import base_env, sub_env
 from baselines.controllers.actuation import wrench_for_targets
 from baselines.controllers.dynamic_constraints import DynamicConstraintsCourse, choose_tau
@@ -119,10 +119,10 @@ class _StatefulPolicy:
         episode_start: np.ndarray | None = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """Action(s) for one flat observation or a batch; ``state`` is passed through. On an
-        env of another view the observation must be the one the env last returned."""
-        if self._planner is not None:
-            observation = self._planner.read(observation)
+        """Action(s) for one observation or a batch (a goal env's Dict read through its
+        ``observation`` entry); ``state`` is passed through. On an env of another view the
+        observation must be the one the env last returned."""
+        observation = planner_input(self._planner, observation)
         return predict_per_env(observation, episode_start, self._row_action), state
 
     def _row_action(self, index: int, observation: np.ndarray, episode_start: bool) -> np.ndarray:

@@ -26,7 +26,7 @@ import numpy as np
 
 from baselines.common.env_model import BodyModel, EnvModel
 from baselines.common.observation_fields import COURSE_SIZE, BodyFields, TrackFields
-from baselines.common.planner_view import PlannerReader, planner_reader
+from baselines.common.planner_view import PlannerReader, planner_input, planner_reader
 from baselines.common.sub_envs import base_env
 from baselines.controllers.actuation import body_wrench
 from baselines.controllers.matched_table import (
@@ -129,11 +129,7 @@ class SGCExpert:
         holds the flat observation. On an env of another view the observation must be the one
         the env last returned: the action is that for the env's planner view of it.
         """
-        if self._planner is not None:
-            observation = self._planner.read(observation)
-        elif isinstance(observation, dict):
-            observation = observation["observation"]
-        obs = np.asarray(observation)
+        obs = planner_input(self._planner, observation)
         if obs.ndim == 1:
             return self.action(obs), state
         return np.stack([self.action(o) for o in obs]), state

@@ -8,6 +8,7 @@ import pytest
 
 import sgc_env  # noqa: F401  (registers the env ids)
 from baselines import DynamicConstraintsController, MinimumJerkController, SGCExpert
+from baselines.evaluation.harness import run_episode
 from baselines.policies import (
     BUILTIN_POLICIES,
     EpisodeExpert,
@@ -143,10 +144,24 @@ def test_make_policy_errors(tmp_path):
         make_policy(str(tmp_path / "missing.zip"), env)
     env.close()
     goal_env = gym.make("SGCPointGoal-v0")
-    with pytest.raises(ValueError, match="flat SGC observation"):
-        make_policy("expert", goal_env)
     assert isinstance(make_policy("random", goal_env, seed=0), RandomPolicy)
     goal_env.close()
+
+
+@pytest.mark.parametrize("env_id", ["SGCPointGoal-v0", "SGCPointGoal-v1"])
+@pytest.mark.parametrize("spec", ["expert", "minimum-jerk", "dynamic-constraints"])
+def test_the_planner_policies_read_a_goal_envs_dict(env_id, spec):
+    """Through the ``observation`` entry (the planner's view) or the env's planner view (the
+    learner's): the expert and minimum jerk meet every goal exactly, dynamic constraints as on
+    the flat id."""
+    env = gym.make(env_id)
+    record = run_episode(make_policy(spec, env), env, seed=3)
+    flat = gym.make("SGCPoint-v0")
+    expected = run_episode(make_policy(spec, flat), flat, seed=3)
+    assert record.card["success_rate"] == expected.card["success_rate"]
+    assert record.card["position_error_max"] == expected.card["position_error_max"]
+    if spec != "dynamic-constraints":
+        assert record.card["position_error_max"] <= 1e-9
 
 
 def test_policy_labels_are_distinct():
