@@ -3,7 +3,7 @@
 rl-zoo3's trainer (``python -m rl_zoo3.train ... -f logs``) leaves one folder per run,
 ``logs/<algo>/<env>_<n>/``, with the model ``<env>.zip``, the ``Monitor`` files of its
 sub-envs and, with ``normalize``, ``<env>/vecnormalize.pkl`` (convert it once with
-``scripts/convert_models.py``: the harness never unpickles). For every run this scores the
+``sgc convert --trust-model``: the harness never unpickles). For every run this scores the
 model with the harness on held-out reset seeds (``--seed`` .. ``--seed + --episodes - 1``,
 none of which training sees) and prints a row; then the interquartile mean of the success
 rates with a 95 % stratified-bootstrap CI (:mod:`baselines.benchmark.aggregate`) and how many

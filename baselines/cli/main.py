@@ -24,6 +24,7 @@ COMMANDS: dict[str, str] = {
     "rollout": "one scenario, one controller: trajectory npz, deviation/path/speed plots, video",
     "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
     "card": "write the model cards of shipped models, with a fresh held-out evaluation",
+    "convert": "trusted SB3 / rl-zoo3 statistics (.pkl) and models into files loaded unpickled",
 }
 
 

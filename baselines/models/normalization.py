@@ -176,7 +176,7 @@ def _from_state(state: Any, env: Any, where: str) -> Any:
 def _refuse_pickle(path: Path) -> ValueError:
     return ValueError(
         f"VecNormalize statistics {path} are a pickle, which can run code when it loads: "
-        f"refused. If you trust the file, convert it once with `python scripts/convert_models.py "
+        f"refused. If you trust the file, convert it once with `sgc convert --trust-model "
         f"{path}` (writes {path.with_suffix('.json').name}) or pass --trust-model"
     )
 

@@ -73,7 +73,7 @@ def check_manifest(folder: str | Path = CHECKPOINTS) -> list[str]:
     problems += [f"{f}: listed, not in {root}" for f in listed if not (root / f).is_file()]
     present = sorted(p.name for p in root.glob("*.zip"))
     problems += [f"{f}: in {root}, not listed" for f in present if f not in listed]
-    problems += [f"{p.name}: a pickle; ship statistics as JSON (scripts/convert_models.py)"
+    problems += [f"{p.name}: a pickle; ship statistics as JSON (sgc convert)"
                  for p in sorted(root.glob("*.pkl"))]  # fmt: skip
     return problems
 
@@ -125,7 +125,7 @@ def ship_model(
         raise ValueError(f"run: no {source.name} in {run_dir}")
     if (run_dir / "vecnormalize.pkl").is_file() and not (run_dir / "vecnormalize.json").is_file():
         raise ValueError(f"run: {run_dir}/vecnormalize.pkl is a pickle; convert it first "
-                         "(scripts/convert_models.py, only for a run you trust)")  # fmt: skip
+                         "(sgc convert --trust-model, only for a run you trust)")  # fmt: skip
     config = load_json(read_bounded(config_path, "run config"), str(config_path))
     if not isinstance(config, dict) or not isinstance(config.get("train_config", {}), dict):
         raise ValueError(f"{config_path}: expected a `sgc train` config object")

@@ -323,15 +323,11 @@ class SGCEnv(gym.Env):
         )  # fmt: skip
         self.torque_scale = self._actuation.torque_scale
         self._view_constants = self._view.constants(self)
-        self._ws_low, self._ws_high = (
-            tuple(map(float, s.workspace[0])),
-            tuple(map(float, s.workspace[1])),
-        )
+        self._ws_low, self._ws_high = (tuple(map(float, corner)) for corner in s.workspace[:2])
 
     @property
     def observation_view(self) -> str:
-        """The name of the view this env observes (``"planner"``, ``"learner"``, or a custom
-        view's ``name``)."""
+        """The name of the view observed: ``"planner"``, ``"learner"`` or a custom view's."""
         return self._view.name
 
     def planner_observation(self) -> np.ndarray:
@@ -340,9 +336,7 @@ class SGCEnv(gym.Env):
 
     @property
     def last_observation(self) -> np.ndarray:
-        """The flat observation last handed out (by ``reset``, ``step``, ``apply_impulse`` or
-        ``restore_state``), in this env's view: what a planner policy checks it was asked
-        about before it reads :meth:`planner_observation`."""
+        """The flat observation last handed out, in this env's view (planner policies check it)."""
         return self._obs
 
     # ---------------------------------------------------------------- reset / step
