@@ -21,6 +21,7 @@ within 16 m of the origin). Colours are the renderer's (sRGB), converted to the 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -226,10 +227,9 @@ class _Builder:
     def build(self, motions: Sequence[Motion], nails: Sequence[Nail]) -> bytes:
         gl, doc = self.gl, self.doc
         root = self._node(gl.Node(name="z-up to y-up", rotation=list(UP_ROTATION)))
-        children = []
-        for motion in motions:
-            children.append(self._motion(motion))
+        motions = [self._with_prop_path(m) for m in motions]  # each prop path drawn once
         moving = self._moving_props(motions)
+        children = [self._motion(motion, moving) for motion in motions]
         still = [k for k in range(len(self.scenario.props)) if k not in moving]
         if still:
             children.append(self._node(gl.Node(
@@ -248,17 +248,20 @@ class _Builder:
         """Props whose drawn position changes in any motion: keyframed inside each group."""
         moving = set()
         for motion in motions:
-            path = self._prop_path(motion)
+            path = motion.prop_positions
+            assert path is not None
             moving |= {k for k in range(path.shape[1]) if np.ptp(path[:, k], axis=0).any()}
         return moving
 
-    def _prop_path(self, motion: Motion) -> np.ndarray:
+    def _with_prop_path(self, motion: Motion) -> Motion:
+        """``motion`` with its props' positions: as given, else each prop's own path."""
         if motion.prop_positions is not None:
-            return motion.prop_positions
-        return np.asarray([[p.position_at(float(t)) for p in self.scenario.props]
+            return motion
+        path = np.asarray([[p.position_at(float(t)) for p in self.scenario.props]
                            for t in motion.times], float).reshape(len(motion.times), -1, 3)
+        return dataclasses.replace(motion, prop_positions=path)
 
-    def _motion(self, motion: Motion) -> int:
+    def _motion(self, motion: Motion, moving: set[int]) -> int:
         gl = self.gl
         orientations = _hemisphere_continuous(motion.orientations)
         samplers: list[Any] = []
@@ -283,8 +286,9 @@ class _Builder:
             keyframe(node, "translation", motion.positions[:, b])
             keyframe(node, "rotation", orientations[:, b])
             members.append(node)
-        path = self._prop_path(motion)
-        for k in sorted(self._moving_props([motion])):
+        path = motion.prop_positions
+        assert path is not None
+        for k in sorted(moving):
             node = self._prop(k, motion, 0, prefix=f"{motion.label}/")
             keyframe(node, "translation", path[:, k])
             members.append(node)
@@ -300,7 +304,7 @@ class _Builder:
         mesh = self._mesh(prop.shape, tuple(float(s) for s in prop.size), prop.color)
         return self._node(gl.Node(
             name=f"{prefix}{prop.name}", mesh=mesh, children=children,
-            translation=[float(x) for x in self._prop_path(motion)[tick, k]],
+            translation=[float(x) for x in np.asarray(motion.prop_positions)[tick, k]],
         ))  # fmt: skip
 
     def _bullseye(self, half: Sequence[float]) -> list[int]:
