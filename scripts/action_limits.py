@@ -55,8 +55,8 @@ def largest_action(policy: str, env_id: str, seed: int) -> dict[str, Any]:
 
 def rows(policy: str, episodes: int, seed: int) -> list[dict[str, Any]]:
     """The paper's scene, then ``episodes`` random rod scenes from ``seed``."""
-    out = [largest_action(policy, "SGCThreeRods-v1", 0)]
-    out += [largest_action(policy, "SGCThreeRodsRandom-v2", seed + i) for i in range(episodes)]
+    out = [largest_action(policy, "SGCThreeRods-v2", 0)]
+    out += [largest_action(policy, "SGCThreeRodsRandom-v3", seed + i) for i in range(episodes)]
     return out
 
 

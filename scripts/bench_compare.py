@@ -9,10 +9,10 @@ sides see the same machine. Prints microseconds per step for both and the cost r
 new / reference (1.000 = same cost).
 
     .venv/bin/python scripts/bench_compare.py --reference /tmp/base [--rounds 40 --chunk 500]
-        [--ids SGCRod-v0 SGCRod-v1]
+        [--ids SGCRod-v1 SGCPoint-v1] [--pair SGCRod-v1=SGCRod-v0]
 
-The last lines set each newest id (``sgc_env.LEARNER_IDS``) against its older version at the
-reference, both measured in this run.
+``--pair NEW=OLD`` sets this checkout's id NEW against the reference's id OLD (another version
+of the same task: a reference checkout from before a version change), on the same scene.
 """
 
 from __future__ import annotations
@@ -70,20 +70,29 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=40)
     parser.add_argument("--chunk", type=int, default=500, help="steps per timed chunk")
     parser.add_argument("--ids", nargs="+", help="only these ids (default: every shared id)")
+    parser.add_argument(
+        "--pair", action="append", default=[], metavar="NEW=OLD",
+        help="this checkout's id NEW against the reference's id OLD (repeatable)",
+    )  # fmt: skip
     args = parser.parse_args()
     reference = load_sgc_env(args.reference.resolve())
     new = load_sgc_env(HERE)
     # ids both checkouts register: a newer id's kwargs may name arguments the reference lacks
-    registry = {k: v for k, v in new._REGISTRY.items()
-                if v[0].endswith(":SGCEnv") and k in reference._REGISTRY
-                and (args.ids is None or k in args.ids)}  # fmt: skip
+    pairs = {k: k for k, v in new._REGISTRY.items()
+             if v[0].endswith(":SGCEnv") and k in reference._REGISTRY
+             and (args.ids is None or k in args.ids)}  # fmt: skip
+    for pair in args.pair:
+        newest, _, old = pair.partition("=")
+        if newest not in new._REGISTRY or old not in reference._REGISTRY:
+            parser.error(f"--pair {pair}: NEW must be registered here and OLD at the reference")
+        pairs[f"{newest}={old}"] = old
     print(
         f"{'id':18} {'ref us/step':>12} {'new us/step':>12} {'wall new/ref':>13} "
         f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12}"
     )
-    results: dict[str, dict[str, list[float]]] = {}
-    for env_id, (_, kwargs) in registry.items():
-        envs = {"ref": fixed_env(reference, kwargs), "new": fixed_env(new, kwargs)}
+    for env_id, old in pairs.items():
+        kwargs, ref_kwargs = new._REGISTRY[env_id.partition("=")[0]][1], reference._REGISTRY[old][1]
+        envs = {"ref": fixed_env(reference, ref_kwargs), "new": fixed_env(new, kwargs)}
         action = hover_action(envs["new"])
         best = {side: [float("inf"), float("inf")] for side in envs}
         for r in range(args.rounds):
@@ -91,18 +100,12 @@ def main() -> None:
                 wall, cpu = chunk_us(envs[side], args.chunk, action)
                 best[side] = [min(best[side][0], wall), min(best[side][1], cpu)]
         (rw, rc), (nw, nc) = best["ref"], best["new"]
-        results[env_id] = best
         print(
             f"{env_id:18} {rw:12.1f} {nw:12.1f} {nw / rw:13.3f} {rc:11.1f} {nc:11.1f} "
             f"{nc / rc:12.3f}"
         )
         for env in envs.values():
             env.close()
-    # the newest version of an id against its older version at the reference (same scenes)
-    for old, newest in zip(new.ENV_IDS, new.LEARNER_IDS, strict=True):
-        if old in results and newest in results:
-            (rw, rc), (nw, nc) = results[old]["ref"], results[newest]["new"]
-            print(f"{newest} new / {old} ref: wall {nw / rw:.3f}, cpu {nc / rc:.3f}")
 
 
 if __name__ == "__main__":

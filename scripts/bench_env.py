@@ -1,6 +1,6 @@
 """Control steps per second of every registered env against a bare PyBullet loop.
 
-Every id of ``sgc_env.ENV_IDS`` and ``sgc_env.LEARNER_IDS``, each on its own view and reward.
+Every id of ``sgc_env.ENV_IDS``, each on its own view and reward.
 
 The bare loop does the same physics in the same process: the same bodies and props, the same
 number of substeps, the same applyExternalForce/Torque (and prop placement) calls per substep,
@@ -126,7 +126,7 @@ def main() -> None:
         help="random-scene resets timed per id",
     )  # fmt: skip
     args = parser.parse_args()
-    ids = (*sgc_env.ENV_IDS, *sgc_env.LEARNER_IDS)
+    ids = sgc_env.ENV_IDS
     width = max(len(env_id) for env_id in ids)
     header = (
         f"{'id':{width}} {'env steps/s':>12} {'bare steps/s':>13} {'ratio':>6} "

@@ -5,8 +5,8 @@
 Prints the median of ``--rounds`` runs of each and their ratio. A model file warms up (imports,
 load) before timing.
 
-    PYTHONPATH=$PWD .venv/bin/python scripts/bench_evaluate.py --env SGCRod-v0 \\
-        --policy expert baselines/checkpoints/ppo_schedule_SGCRod-v0.zip --episodes 8
+    PYTHONPATH=$PWD .venv/bin/python scripts/bench_evaluate.py --env SGCRod-v1 \\
+        --policy expert baselines/checkpoints/ppo_schedule_SGCRod-v1.zip --episodes 8
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def _timed(policy: str, env_id: str, episodes: int, num_envs: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--env", default="SGCRod-v0")
+    parser.add_argument("--env", default="SGCRod-v1")
     parser.add_argument("--policy", nargs="+", default=["expert"])
     parser.add_argument("--episodes", type=int, default=8)
     parser.add_argument("--num-envs", type=int, default=8)

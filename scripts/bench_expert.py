@@ -34,7 +34,7 @@ from baselines.controllers.expert import GOAL_TICK_SLACK, SGCExpert
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_env import BareLoop, env_step_us, fixed_env, hover_action  # noqa: E402
 
-ENV_IDS = ("SGCRod-v0", "SGCThreeRods-v1")
+ENV_IDS = ("SGCRod-v1", "SGCThreeRods-v2")
 
 
 def record_episodes(env_id: str, episodes: int) -> tuple[SGCExpert, list[np.ndarray], list[bool]]:
@@ -113,7 +113,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5, help="physics rounds; best is kept")
     args = parser.parse_args()
     for env_id in ENV_IDS:
-        episodes = args.episodes if env_id == "SGCRod-v0" else 1  # the three-rod demo is fixed
+        episodes = args.episodes if env_id == "SGCRod-v1" else 1  # the three-rod demo is fixed
         expert, observations, goal_tick = record_episodes(env_id, episodes)
         cost = time_actions(expert, observations, args.repeats)
         unrefined = SGCExpert(model=expert.model, refine=False)

@@ -11,7 +11,7 @@ client put back to its start pose and velocity); its share of stepping a full-le
 draw is feasible by construction and never checks); and whether the wall time (``yes``), only
 the CPU time (``cpu``) or neither (``no``) stays within issue 19's 10 ms. Then, as before:
 
-For SGCIntercept(Random)-v0 and SGCThreeRods-v1 / SGCThreeRodsRandom-v2: mean
+For SGCIntercept(Random)-v0 and SGCThreeRods-v2 / SGCThreeRodsRandom-v3: mean
 ``env.reset(seed=...)`` time on the unwrapped env, the ratio random / fixed, how many
 feasibility checks (the planner's ``demand_bounds`` per drawn interception, the planner-free
 course bound per drawn rod that enters the board) a kept scene took, and the mean time of one
@@ -42,8 +42,8 @@ from sgc_env.scenes import intercept, random_scenario, three_rods_random
 
 TARGET_MS = 10.0
 """Issue 19's bound on a random id's reset (about a tenth of its episode's steps)."""
-PAIRS = (("SGCIntercept-v0", "SGCInterceptRandom-v0", "intercept"),
-         ("SGCThreeRods-v1", "SGCThreeRodsRandom-v2", "three_rods"))  # fmt: skip
+PAIRS = (("SGCIntercept-v1", "SGCInterceptRandom-v1", "intercept"),
+         ("SGCThreeRods-v2", "SGCThreeRodsRandom-v3", "three_rods"))  # fmt: skip
 
 
 def _bare_reset_ms(resets: int) -> float:

@@ -7,7 +7,7 @@ run (the first ``--configs`` entry), each in a fresh child process, one after th
 :func:`baselines.agents.train.train` (the whole `sgc train` path, updates included) for
 ``--steps`` env steps, no evaluation::
 
-    .venv/bin/python scripts/bench_recipes.py --env SGCRod-v0 --steps 32768 \
+    .venv/bin/python scripts/bench_recipes.py --env SGCRod-v1 --steps 32768 \
         --configs ppo_schedule:dummy ppo_schedule:batched ppo_rod_alive64:batched ppo_rod300:batched
 """
 
@@ -33,7 +33,7 @@ def child(env_id: str, folder: str, vec: str, steps: int) -> dict[str, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--env", default="SGCRod-v0")
+    parser.add_argument("--env", default="SGCRod-v1")
     parser.add_argument("--steps", type=int, default=32768, help="env steps per timed run")
     parser.add_argument("--configs", nargs="+",
                         default=["ppo_schedule:dummy", "ppo_rod300:batched"],

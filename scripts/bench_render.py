@@ -3,7 +3,7 @@ PyBullet offers here, as ratios.
 
 Usage: .venv/bin/python scripts/bench_render.py [--frames 12] [--width 960] [--height 540]
 
-First ``env.render()`` of ``SGCThreeRods-v1`` at its default 640x480 (fixed camera) during an
+First ``env.render()`` of ``SGCThreeRods-v2`` at its default 640x480 (fixed camera) during an
 expert episode, against a bare TinyRenderer frame of the env's own physics client (no floor,
 PyBullet's default look) of the same size through the same camera, both in this run; the
 issue's budget is 60 ms of CPU per frame. Then the demo's scene at t = 2 s through the demo's
@@ -39,7 +39,7 @@ import sgc_env
 from sgc_env.simulator import pybullet as pb
 from baselines.figures.demo_camera import camera_at
 w, h, n = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
-env = gym.make("SGCThreeRods-v1"); base = env.unwrapped
+env = gym.make("SGCThreeRods-v2"); base = env.unwrapped
 loader = pkgutil.get_loader("eglRenderer")
 if loader is None:
     print(json.dumps({"error": "no eglRenderer module"})); sys.exit()
@@ -104,7 +104,7 @@ def main() -> None:
     n = args.frames
     env_rows = _env_render(n, per_frame, pb, SGCExpert)
     w, h = args.width, args.height
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     _, info = env.reset(seed=0)
     base: Any = env.unwrapped  # the SGCEnv
     pierced = [three_rods.PIERCE_TIME] * len(base.scenario.bodies)  # as the expert pierces
@@ -161,7 +161,7 @@ def main() -> None:
     )
 
     (ew, eh), env_reference = env_rows[0], env_rows[1][1]
-    print(f"env.render() of SGCThreeRods-v1, {ew}x{eh}, fixed camera, mean of {n} frames of an "
+    print(f"env.render() of SGCThreeRods-v2, {ew}x{eh}, fixed camera, mean of {n} frames of an "
           f"expert episode, CPU s per frame (ratio to the bare frame)")  # fmt: skip
     for name, seconds in env_rows[1:]:
         print(f"  {name:62s} {seconds:7.4f}  ({seconds / env_reference:5.2f}x)")
@@ -180,11 +180,11 @@ def main() -> None:
 
 
 def _env_render(n: int, per_frame, pb, expert_class) -> list:
-    """[(width, height), (bare row), (env.render row)] on SGCThreeRods-v1 at its defaults: the
+    """[(width, height), (bare row), (env.render row)] on SGCThreeRods-v2 at its defaults: the
     frames are taken along an expert episode (every 4th tick), so trails and poses vary."""
     import gymnasium as gym
 
-    env = gym.make("SGCThreeRods-v1", render_mode="rgb_array")
+    env = gym.make("SGCThreeRods-v2", render_mode="rgb_array")
     expert = expert_class(env)
     obs, _ = env.reset(seed=0)
     base: Any = env.unwrapped

@@ -7,7 +7,7 @@ Needs a venv with both (SBX is not a project dependency)::
         scipy matplotlib imageio rich tqdm
     PYTHONPATH=$PWD /work/scratch-sbx/bin/python scripts/bench_sbx.py [--ppo-steps 8192]
 
-Each library trains PPO and SAC on SGCPoint-v0 with the hyperparameters of
+Each library trains PPO and SAC on SGCPoint-v1 with the hyperparameters of
 baselines/hyperparams/{ppo,sac}.yml (256-256 networks; PPO 4 envs x 512 steps, 10 epochs, batch 256;
 SAC one gradient step of batch 256 per env step, from step 100). Every measurement follows
 a short warm-up run of the same model (JIT compilation, allocator), and the libraries
@@ -32,7 +32,7 @@ import torch  # noqa: E402
 import sgc_env  # noqa: E402, F401  (registers the ids)
 from baselines.agents.hyperparams import load_hyperparams  # noqa: E402
 
-ENV_ID = "SGCPoint-v0"
+ENV_ID = "SGCPoint-v1"
 
 
 def _model(lib: str, algo: str, seed: int):

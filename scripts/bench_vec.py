@@ -11,7 +11,7 @@ one epoch, minibatch ``min(1024, N * n_steps)``, two rollouts timed after a warm
 Ratios are against DummyVecEnv at the same N, measured in this run; read them, not the
 absolute rates, on a busy machine (``--repeats`` runs the kinds in turn, keeps each's best).
 
-    .venv/bin/python scripts/bench_vec.py --ids SGCRod-v0 --n 1 8 64 256 --ppo
+    .venv/bin/python scripts/bench_vec.py --ids SGCRod-v1 --n 1 8 64 256 --ppo
 """
 
 from __future__ import annotations

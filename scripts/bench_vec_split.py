@@ -10,8 +10,8 @@ cannot do without), and three ratios to DummyVecEnv: measured; with scene draws 
 kinds (the draw is the same code in both); and a batched env that cost nothing but PyBullet's
 calls and its draws. Each figure is the best of ``--repeats`` passes; run it on a quiet core.
 
-    taskset -c 0 .venv/bin/python scripts/bench_vec_split.py --ids SGCThreeRodsRandom-v2 \
-        SGCThreeRodsRandom-v3 SGCRod-v0
+    taskset -c 0 .venv/bin/python scripts/bench_vec_split.py --ids SGCThreeRodsRandom-v3 \
+        SGCThreeRodsRandom-v3 SGCRod-v1
 """
 
 from __future__ import annotations
@@ -157,7 +157,7 @@ def report(env_id: str, n: int, ticks: int, repeats: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "--ids", nargs="+", default=["SGCThreeRodsRandom-v2", "SGCThreeRodsRandom-v3"]
+        "--ids", nargs="+", default=["SGCThreeRodsRandom-v3", "SGCThreeRodsRandom-v3"]
     )
     parser.add_argument("--n", type=int, default=64)
     parser.add_argument("--ticks", type=int, default=320, help="steps of all N sub-envs timed")
@@ -170,7 +170,7 @@ def main() -> None:
         check_num_envs(args.n)
     except ValueError as err:
         parser.error(f"--n: {err}")
-    ids = (*sgc_env.ENV_IDS, *sgc_env.LEARNER_IDS)
+    ids = sgc_env.ENV_IDS
     for env_id in args.ids:
         if env_id not in ids:
             parser.error(f"--ids: {env_id!r} is not an SGC id; ids: {list(ids)}")

@@ -13,7 +13,7 @@ mkdir "$work/src"
 git ls-files -z --cached --others --exclude-standard | xargs -0 cp --parents -t "$work/src"
 .venv/bin/python -m pip wheel --no-deps --progress-bar off -w "$work/dist" "$work/src" >/dev/null
 wheel="$(ls "$work"/dist/sgc-*.whl)"
-unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint-v0.(zip|md)|export/viewer.html"
+unzip -l "$wheel" | grep -E "hyperparams/ppo.yml|scenario/builtin/three_rods.yaml|ppo_dagger_SGCPoint-v1.(zip|md)|export/viewer.html"
 cards="$(unzip -l "$wheel" | grep -c "baselines/checkpoints/.*\.md$")"
 test "$cards" -eq "$(ls baselines/checkpoints/*.md | wc -l)"  # every shipped model's card
 step "2/4 install $(basename "$wheel")[rl] into a fresh venv"
@@ -29,9 +29,9 @@ assert "site-packages" in baselines.__file__ and "site-packages" in sgc_env.__fi
 print("imports from", baselines.__file__)
 PY
 step "3/4 sgc train (one PPO rollout) from $PWD"
-"$work/venv/bin/sgc" train --algo ppo --env SGCPoint-v0 --timesteps 2048 --out train
+"$work/venv/bin/sgc" train --algo ppo --env SGCPoint-v1 --timesteps 2048 --out train
 step "4/4 sgc evaluate: the expert and the shipped models (a clone, one learned from scratch)"
-"$work/venv/bin/sgc" evaluate --env SGCPoint-v0 --policy expert,shipped:SGCPoint-v0,shipped:ppo_schedule_SGCPoint-v0 \
+"$work/venv/bin/sgc" evaluate --env SGCPoint-v1 --policy expert,shipped:SGCPoint-v1,shipped:ppo_schedule_SGCPoint-v1 \
     --episodes 2 --no-plots --out evaluate
 test -s evaluate/scorecard.md && test -s train/final_model.zip
 "$work/venv/bin/sgc" demo --no-video --out demo  # the glTF file and its viewer page, from the wheel

@@ -1,6 +1,6 @@
 """Write the expert's GIF of every env card into docs/images/ (``expert_<id>.gif``).
 
-Usage: PYTHONPATH=$PWD .venv/bin/python scripts/env_gifs.py [--ids SGCRod-v0 ...] [--seed 0]
+Usage: PYTHONPATH=$PWD .venv/bin/python scripts/env_gifs.py [--ids SGCRod-v1 ...] [--seed 0]
 
 240x180 at 8 fps, seed 0 (the same scene the card describes for a fixed id; the first drawn
 scene for a random one). Prints each file's size: keep them at a few hundred KB.

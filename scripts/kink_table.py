@@ -2,8 +2,8 @@
 
 The kink is the largest one-tick change of acceleration over a body's whole track
 (docs/metrics.md), linear (the tracked point) and angular. For every rod of the paper's
-three-rod scene (``SGCThreeRods-v1``) and of held-out random rod scenes
-(``SGCThreeRodsRandom-v2``, seeds from 10000) it prints the expert's kinks, minimum jerk's and
+three-rod scene (``SGCThreeRods-v2``) and of held-out random rod scenes
+(``SGCThreeRodsRandom-v3``, seeds from 10000) it prints the expert's kinks, minimum jerk's and
 their ratio; the issue asks for a ratio of at most 2 everywhere. Exit status 1 when a ratio
 exceeds ``--limit``.
 
@@ -61,8 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     )  # fmt: skip
     parser.add_argument("--limit", type=float, default=2.0, help="largest ratio that passes")
     args = parser.parse_args(argv)
-    rows = compare("SGCThreeRods-v1", 1, 0, args.policy)
-    rows += compare("SGCThreeRodsRandom-v2", args.episodes, args.seed, args.policy)
+    rows = compare("SGCThreeRods-v2", 1, 0, args.policy)
+    rows += compare("SGCThreeRodsRandom-v3", args.episodes, args.seed, args.policy)
     print(f"| env | episode | rod | goals met | {args.policy} kink (m/s²) | minimum jerk | ratio "
           f"| {args.policy} angular kink (rad/s²) | minimum jerk | ratio |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|---|")

@@ -47,13 +47,13 @@ RESULTS = {
         "runs/demo-learned/rods.json",
     ),
     "smoothness": Result(
-        "sgc evaluate --env SGCPoint-v0,SGCRod-v0,SGCThreeRods-v1,SGCIntercept-v0,"
-        "SGCInterceptRandom-v0,SGCThreeRodsRandom-v2 --policy expert,expert-paper,minimum-jerk "
+        "sgc evaluate --env SGCPoint-v1,SGCRod-v1,SGCThreeRods-v2,SGCIntercept-v1,"
+        "SGCInterceptRandom-v1,SGCThreeRodsRandom-v3 --policy expert,expert-paper,minimum-jerk "
         "--episodes 20 --seed 10000 --no-plots --out runs/smoothness",
         "runs/smoothness/scorecard.md",
     ),
     "paper-rule": Result(
-        "sgc evaluate --env SGCThreeRods-v1 --policy expert,expert-paper --episodes 1 "
+        "sgc evaluate --env SGCThreeRods-v2 --policy expert,expert-paper --episodes 1 "
         "--seed 77 --no-plots --out runs/paper-rule",
         "runs/paper-rule/scorecard.md",
     ),

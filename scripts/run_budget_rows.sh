@@ -4,7 +4,7 @@
 # 2-core machine; torch uses one thread per run). Resumable: rerun the same command and the
 # finished runs are skipped; with --report-only it runs nothing and writes the leaderboard
 # from the runs finished so far. Extra arguments go to `sgc benchmark`.
-#   scripts/run_budget_rows.sh                 # everything (about 4 h on 2 quiet cores)
+#   scripts/run_budget_rows.sh                 # everything (18,000 s of training: about 3 h on 2 quiet cores)
 #   scripts/run_budget_rows.sh --report-only   # the leaderboard so far
 # Environment: OUT (runs/benchmark/budget), SEEDS (10), WORKERS (2), SGC (.venv/bin/sgc).
 set -euo pipefail
@@ -14,15 +14,14 @@ SEEDS=${SEEDS:-10}
 WORKERS=${WORKERS:-2}
 SGC=${SGC:-.venv/bin/sgc}
 # keep in step with the budget recipes of benchmarks/recipes.yml (tests/baselines/agents/test_budget.py checks)
-ROWS=ppo-rod300-300s,sac-300s,td3-300s,ppo-raw-300s,bc-dagger-300s
-ROWS=$ROWS,ppo-point500k-120s,ppo-raw-120s,sac-120s,td3-120s,her-time-120s,bc-dagger-120s
-ROWS=$ROWS,zoo-ppo-300s,zoo-ppo-120s,zoo-sac-120s,zoo-td3-120s
+ROWS=zoo-ppo-300s,zoo-sac-300s,zoo-td3-300s,bc-dagger-300s
+ROWS=$ROWS,zoo-ppo-120s,zoo-sac-120s,zoo-td3-120s,zoo-her-120s,bc-dagger-120s
 if [[ " $* " != *" --report-only "* ]]; then
-    for env in SGCPoint-v0 SGCRod-v0; do  # the BC+DAgger rows' demonstrations (not timed)
+    for env in SGCPoint-v1 SGCRod-v1; do  # the BC+DAgger rows' demonstrations (not timed)
         demos=runs/benchmark-demos/${env}_100.npz
         [[ -f $demos ]] || "$SGC" demos --env "$env" --episodes 100 --seed 0 --out "$demos"
     done
 fi
 exec "$SGC" benchmark --recipes benchmarks/recipes.yml --only "$ROWS" \
-    --env SGCPoint-v0,SGCPointGoal-v0,SGCRod-v0,SGCPoint-v1,SGCRod-v1 --seeds "$SEEDS" --eval-episodes 50 \
+    --env SGCPoint-v1,SGCPointGoal-v1,SGCRod-v1 --seeds "$SEEDS" --eval-episodes 50 \
     --workers "$WORKERS" --out "$OUT" "$@"

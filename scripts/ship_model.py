@@ -2,12 +2,12 @@
 
 From a run folder (``sgc train --out DIR`` or a ``sgc benchmark`` run)::
 
-    python scripts/ship_model.py --run runs/benchmark/point/runs/SGCPoint-v0/ppo/seed0 \
-        --name ppo_SGCPoint-v0 [--which best|final] [--episodes 50] [--seed 20000]
+    python scripts/ship_model.py --run runs/benchmark/point/runs/SGCPoint-v1/ppo/seed0 \
+        --name ppo_SGCPoint-v1 [--which best|final] [--episodes 50] [--seed 20000]
 
 or, for a model already in the folder whose run is gone, the facts by hand::
 
-    python scripts/ship_model.py --existing ppo_dagger_SGCPoint-v0.zip --env SGCPoint-v0 \
+    python scripts/ship_model.py --existing ppo_dagger_SGCPoint-v1.zip --env SGCPoint-v1 \
         --algo ppo --demonstrations --timesteps 0 --train-seed 0 --wall-time 139 \
         --command "sgc train ..." [--episodes 50] [--seed 10000]
 

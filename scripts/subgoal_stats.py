@@ -28,8 +28,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--episodes", type=int, default=5, help="random scenes (default 5)")
     parser.add_argument("--seed", type=int, default=EVAL_SEED)
     args = parser.parse_args(argv)
-    scenes = [("SGCThreeRods-v1", 0)]
-    scenes += [("SGCThreeRodsRandom-v2", args.seed + i) for i in range(args.episodes)]
+    scenes = [("SGCThreeRods-v2", 0)]
+    scenes += [("SGCThreeRodsRandom-v3", args.seed + i) for i in range(args.episodes)]
     lengths: dict[str, list[np.ndarray]] = {"position": [], "orientation": []}
     seconds = []
     for env_id, seed in scenes:

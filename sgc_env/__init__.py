@@ -6,6 +6,8 @@ Importing the package registers the ids in :data:`ENV_IDS` with Gymnasium, each 
 
 from __future__ import annotations
 
+import warnings
+
 import gymnasium as gym
 
 from sgc_env.episode_steps import registered_steps
@@ -14,7 +16,6 @@ from sgc_env.scenario import Body, Goal, Prop, Scenario, ScenarioError, load_sce
 
 __all__ = [
     "ENV_IDS",
-    "LEARNER_IDS",
     "check_env_id",
     "Body",
     "Goal",
@@ -27,33 +28,23 @@ __all__ = [
 
 _ENTRY = "sgc_env.envs.sgc_env:SGCEnv"
 _GOAL = "sgc_env.envs.goal_env"
-_REGISTRY: dict[str, tuple[str, dict]] = {
-    "SGCPoint-v0": (_ENTRY, {"random_scenario": "point"}),
-    "SGCRod-v0": (_ENTRY, {"random_scenario": "rod"}),
-    "SGCThreeRods-v1": (_ENTRY, {"scenario": "three_rods"}),
-    "SGCIntercept-v0": (_ENTRY, {"scenario": "intercept"}),
-    "SGCInterceptRandom-v0": (_ENTRY, {"random_scenario": "intercept"}),
-    "SGCThreeRodsRandom-v2": (_ENTRY, {"random_scenario": "three_rods"}),
-    "SGCPointGoal-v0": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point"}),
-}
-ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
-"""The ids on the planner's view and the ``schedule`` reward: the benchmark's leaderboards,
-the shipped models and the scorecard use these versions."""
-
 _LEARNER = {"observation": "learner", "reward": "tracking"}
-_NEXT_VERSION = {
-    "SGCPoint-v0": "SGCPoint-v1", "SGCRod-v0": "SGCRod-v1", "SGCThreeRods-v1": "SGCThreeRods-v2",
-    "SGCIntercept-v0": "SGCIntercept-v1", "SGCInterceptRandom-v0": "SGCInterceptRandom-v1",
-    "SGCThreeRodsRandom-v2": "SGCThreeRodsRandom-v3", "SGCPointGoal-v0": "SGCPointGoal-v1",
+_REGISTRY: dict[str, tuple[str, dict]] = {
+    "SGCPoint-v1": (_ENTRY, {"random_scenario": "point", **_LEARNER}),
+    "SGCRod-v1": (_ENTRY, {"random_scenario": "rod", **_LEARNER}),
+    "SGCThreeRods-v2": (_ENTRY, {"scenario": "three_rods", **_LEARNER}),
+    "SGCIntercept-v1": (_ENTRY, {"scenario": "intercept", **_LEARNER}),
+    "SGCInterceptRandom-v1": (_ENTRY, {"random_scenario": "intercept", **_LEARNER}),
+    "SGCThreeRodsRandom-v3": (_ENTRY, {"random_scenario": "three_rods", **_LEARNER}),
+    "SGCPointGoal-v1": (f"{_GOAL}:SGCGoalEnv", {"random_scenario": "point",
+                                                "observation": "learner"}),
 }  # fmt: skip
-LEARNER_IDS: tuple[str, ...] = tuple(_NEXT_VERSION.values())
-"""The newest version of every id: the same scenes and dynamics with the learner's view
-(``observation="learner"``, :mod:`sgc_env.envs.learner_view`) and, but for the goal id (whose
-reward is its sparse goal reward), the ``tracking`` reward (:mod:`sgc_env.envs.rewards`)."""
-for _old, _new in _NEXT_VERSION.items():
-    _entry, _kwargs = _REGISTRY[_old]
-    _extra = {"observation": "learner"} if _entry.startswith(_GOAL) else _LEARNER
-    _REGISTRY[_new] = (_entry, {**_kwargs, **_extra})
+ENV_IDS: tuple[str, ...] = tuple(_REGISTRY)
+"""One id per task, each at its one current version: the learner's view
+(:mod:`sgc_env.envs.learner_view`) and, but for the goal id (whose reward is its sparse goal
+reward), the ``tracking`` reward (:mod:`sgc_env.envs.rewards`). An earlier version of an id
+(``SGCPoint-v1``, say) is not registered: ``gym.make`` answers it with Gymnasium's own
+``DeprecatedEnv``, naming the current one (the migration table is in CHANGELOG.md)."""
 
 for _id, (_entry, _kwargs) in _REGISTRY.items():
     if _id not in gym.registry:
@@ -75,9 +66,19 @@ for _id, (_entry, _kwargs) in _REGISTRY.items():
 
 
 def check_env_id(env_id: object, field: str = "env_id") -> str:
-    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field`` and the
-    SGC ids (the one check of the package, the harness, training and the CLI)."""
-    if not isinstance(env_id, str) or env_id not in gym.registry:
-        known = list(ENV_IDS + LEARNER_IDS)
-        raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {known}")
-    return env_id
+    """``env_id`` when Gymnasium has it registered; else a ValueError naming ``field``: for an
+    earlier version of an SGC id, Gymnasium's own ``DeprecatedEnv`` message (which names the
+    current id), for anything else the SGC ids (the one check of the package, the harness,
+    training and the CLI)."""
+    if isinstance(env_id, str) and env_id in gym.registry:
+        return env_id
+    if isinstance(env_id, str):
+        try:
+            with warnings.catch_warnings():  # the error below says it; no second line before it
+                warnings.simplefilter("ignore", DeprecationWarning)
+                gym.spec(env_id)
+        except gym.error.DeprecatedEnv as error:
+            raise ValueError(f"{field}: {error}") from None
+        except gym.error.Error:
+            pass
+    raise ValueError(f"{field}: unknown environment {env_id!r}; SGC ids: {list(ENV_IDS)}")

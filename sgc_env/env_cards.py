@@ -118,19 +118,19 @@ CARDS: tuple[EnvCard, ...] = (
         "SGCIntercept",
         "The paper's interception: a bird (a 0.5 kg sphere) passes a nail and then meets a "
         "fish swimming on a fixed path exactly at the meeting time. One scene, so a score can "
-        "be memorisation; `SGCInterceptRandom-v0` draws it anew.",
+        "be memorisation; `SGCInterceptRandom-v1` draws it anew.",
         "The bird at rest at (0, 0, 2) m; the fish at (2, -0.5, 0.5) m, swimming through "
         "(1.5, 0, 0.6) m at 1 s and on towards (1, 1, 0.5) m. No noise: every reset is the "
         "same state.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCIntercept-v0"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCIntercept-v1"))),
     ),
     EnvCard(
         "SGCInterceptRandom",
-        "`SGCIntercept-v0` with the target path, the meeting time (1.2-2.5 s) and the bird's "
+        "`SGCIntercept-v1` with the target path, the meeting time (1.2-2.5 s) and the bird's "
         "start drawn per reset.",
         _RANDOM_START + "the bird within 0.5 m of (0, 0, 2) at up to 1.5 m/s, the fish within "
         "0.6 m of (2, -0.5, 0.5) swimming two straight legs at 0.3-1.5 m/s.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCInterceptRandom-v0"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCInterceptRandom-v1"))),
     ),
     EnvCard(
         "SGCPoint",
@@ -138,16 +138,16 @@ CARDS: tuple[EnvCard, ...] = (
         "its goal time, and move smoothly through them (Liu, Ko & Chang 1993, point goals).",
         _RANDOM_START + "the sphere at rest at (0, 0, 1) m, 3 goals with course lengths, "
         "speeds, turn angles and time-critical shares drawn from the `point` preset.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPoint-v0"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPoint-v1"))),
     ),
     EnvCard(
         "SGCPointGoal",
-        "`SGCPoint-v0` as a goal-conditioned task for hindsight relabelling (SB3's "
+        "`SGCPoint-v1` as a goal-conditioned task for hindsight relabelling (SB3's "
         "`HerReplayBuffer`): a Dict observation and a sparse reward computed by "
         "`compute_reward`.",
-        "As `SGCPoint-v0` (the same draws for the same seed).",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPointGoal-v0", goal=True))),
-        gif_of="SGCPoint-v0",
+        "As `SGCPoint-v1` (the same draws for the same seed).",
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPointGoal-v1", goal=True))),
+        gif_of="SGCPoint-v1",
     ),
     EnvCard(
         "SGCRod",
@@ -156,7 +156,7 @@ CARDS: tuple[EnvCard, ...] = (
         "torques.",
         _RANDOM_START + "the rod at rest at (0, 0, 1) m, upright, 3 goals drawn from the "
         "`rod` preset (relative rotations on).",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCRod-v0"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version("SGCRod-v1"))),
     ),
     EnvCard(
         "SGCThreeRods",
@@ -166,17 +166,17 @@ CARDS: tuple[EnvCard, ...] = (
         "The three rods at the scene's launch poses, x about -9.2 m, flying at 2-2.5 m/s "
         "towards the board at x = 8 m; the balls at their start points. No noise.",
         (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT),
-         Version("v2", _learner_version("SGCThreeRods-v1"))),
+         Version("v2", _learner_version("SGCThreeRods-v2"))),
     ),
     EnvCard(
         "SGCThreeRodsRandom",
-        "`SGCThreeRods-v1` with the paths, goal counts, balls and times drawn per reset.",
+        "`SGCThreeRods-v2` with the paths, goal counts, balls and times drawn per reset.",
         _RANDOM_START + "every waypoint of the paper's paths moved by up to 0.4 m, pierce "
         "times 1.0-1.4 s, hit times within 0.4 s of the paper's, ball velocities 0.5-1.2 m/s, "
         "and only draws whose bound of the plan's force and torque stays within 80 % of each "
         "limit.",
         (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT), Version("v2", _COURSE_BOUND),
-         Version("v3", _learner_version("SGCThreeRodsRandom-v2"))),
+         Version("v3", _learner_version("SGCThreeRodsRandom-v3"))),
     ),
 )
 

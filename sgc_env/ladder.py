@@ -29,21 +29,21 @@ class Rung:
 
 
 LADDER: tuple[Rung, ...] = (
-    Rung("SGCIntercept-v0", "meet a moving target exactly at its time; one scene, memorisable"),
+    Rung("SGCIntercept-v1", "meet a moving target exactly at its time; one scene, memorisable"),
     Rung(
-        "SGCInterceptRandom-v0",
+        "SGCInterceptRandom-v1",
         "the same, with target path, meeting time and start state drawn per reset",
     ),
-    Rung("SGCPoint-v0", "a routed sequence: exact and punctual at every goal, smooth through it"),
-    Rung("SGCPointGoal-v0", "`SGCPoint-v0` as a goal-conditioned task (Dict observation, HER)"),
-    Rung("SGCRod-v0", "position and orientation together: torques on a thin rod"),
+    Rung("SGCPoint-v1", "a routed sequence: exact and punctual at every goal, smooth through it"),
+    Rung("SGCPointGoal-v1", "`SGCPoint-v1` as a goal-conditioned task (Dict observation, HER)"),
+    Rung("SGCRod-v1", "position and orientation together: torques on a thin rod"),
     Rung(
-        "SGCThreeRods-v1",
+        "SGCThreeRods-v2",
         "the paper's scene: three rods, long point-to-path sequences, tip goals, moving balls, "
         "a somersault; one scene",
     ),
     Rung(
-        "SGCThreeRodsRandom-v2",
+        "SGCThreeRodsRandom-v3",
         "the same, with paths, goal counts, balls and times drawn per reset",
     ),
 )

@@ -109,23 +109,23 @@ def _prop_waypoints(n: int, tmp: Path) -> None:
 def _sim_frequency(n: int, tmp: Path) -> None:
     from baselines.common.env_kwargs import check_env_kwargs
 
-    check_env_kwargs("SGCPoint-v0", {"sim_frequency": n, "control_frequency": 1000}, "kwargs")
+    check_env_kwargs("SGCPoint-v1", {"sim_frequency": n, "control_frequency": 1000}, "kwargs")
 
 
 def _n_envs(n: int, tmp: Path) -> None:
     from baselines.agents.hyperparams import load_hyperparams
 
-    (tmp / "ppo.yml").write_text(f"SGCPoint-v0: {{n_timesteps: 64, policy: MlpPolicy, "
+    (tmp / "ppo.yml").write_text(f"SGCPoint-v1: {{n_timesteps: 64, policy: MlpPolicy, "
                                  f"n_envs: {n}}}\n")  # fmt: skip
-    load_hyperparams("ppo", "SGCPoint-v0", tmp)
+    load_hyperparams("ppo", "SGCPoint-v1", tmp)
 
 
 def _net(net_arch: list[int], tmp: Path) -> None:
     from baselines.agents.hyperparams import load_hyperparams
 
-    (tmp / "ppo.yml").write_text(f"SGCPoint-v0: {{n_timesteps: 64, policy: MlpPolicy, "
+    (tmp / "ppo.yml").write_text(f"SGCPoint-v1: {{n_timesteps: 64, policy: MlpPolicy, "
                                  f"policy_kwargs: 'dict(net_arch={net_arch})'}}\n")  # fmt: skip
-    load_hyperparams("ppo", "SGCPoint-v0", tmp)
+    load_hyperparams("ppo", "SGCPoint-v1", tmp)
 
 
 def _net_parameters(n: int, tmp: Path) -> None:
@@ -140,7 +140,7 @@ def _clean_zip(tmp: Path) -> Path:
 
     import sgc_env  # noqa: F401
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     path = tmp / "clean.zip"
     PPO("MlpPolicy", env, n_steps=64, batch_size=64, device="cpu",
         policy_kwargs={"net_arch": [8]}).save(path)  # fmt: skip
@@ -153,7 +153,7 @@ def _load_model(path: Path) -> None:
 
     from baselines.models.model_files import load_sb3_model
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     try:
         load_sb3_model(path, env=env)
     finally:
@@ -200,7 +200,7 @@ def _demos(tmp: Path, rows: int) -> Path:
     np.savez(path, observations=obs, actions=obs, rewards=obs[:, 0],
              terminations=np.zeros(rows, bool), truncations=np.zeros(rows, bool),
              episode_starts=np.ones(rows, bool), seeds=np.arange(1),
-             env_id=np.array("SGCPoint-v0"), env_kwargs=np.array("{}"), pushes=np.array("{}"),
+             env_id=np.array("SGCPoint-v1"), env_kwargs=np.array("{}"), pushes=np.array("{}"),
              format_version=np.array(1))  # fmt: skip
     return path
 

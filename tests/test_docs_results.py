@@ -73,7 +73,7 @@ def test_readme_summary_is_the_results_leaderboard() -> None:
     ((readme, text),) = _pasted(paste.SUMMARY)
     assert readme.name == "README.md"
     assert text == paste.summary_block((ROOT / paste.SUMMARY_SOURCE).read_text())
-    assert "| `SGCRod-v0` | `ppo-rod300-300s` | no | 10 | 76 | 0.92 [0.84, 0.98] |" in text
+    assert "| `SGCRod-v1` | `ppo-rod300-300s` | no | 10 | 76 | 0.92 [0.84, 0.98] |" in text
 
 
 def test_a_table_needs_its_markers_once() -> None:

@@ -32,7 +32,7 @@ from baselines.cli import main as cli  # noqa: E402
 
 SHIPPED = Path(__file__).resolve().parents[1] / "baselines" / "checkpoints"
 GIB = 1 << 30
-POINT = "SGCPoint-v0"
+POINT = "SGCPoint-v1"
 ANSI = "\x1b[32m\nsgc evaluate: ok\x1b[0m"
 
 
@@ -117,7 +117,7 @@ def _links_in_out(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
     out.mkdir()
     (out / "summary.json").symlink_to(victim)
     (out / "deviation.png").symlink_to(tmp / "dangling")
-    return ["rollout", "--env", "SGCPoint-v0", "--no-compare", "--out", str(out)], None
+    return ["rollout", "--env", "SGCPoint-v1", "--no-compare", "--out", str(out)], None
 
 
 SCENARIOS: dict[str, Case] = {
@@ -160,7 +160,7 @@ SCENARIOS: dict[str, Case] = {
 # ---------------------------------------------------------------- model zips (sgc evaluate)
 
 
-def _evaluate(model: Path, tmp: Path, env: str = "SGCPoint-v0") -> list[str]:
+def _evaluate(model: Path, tmp: Path, env: str = "SGCPoint-v1") -> list[str]:
     return ["evaluate", "--policy", str(model), "--env", env, "--episodes", "1", "--no-plots",
             "--out", str(tmp / "out")]  # fmt: skip
 
@@ -185,7 +185,7 @@ def _edit_zip(source: Path, target: Path, data: Callable[[dict], Any] | None = N
     return target
 
 
-def _model(edit: Callable[[dict], Any] | None = None, env: str = "SGCPoint-v0",
+def _model(edit: Callable[[dict], Any] | None = None, env: str = "SGCPoint-v1",
            source: Path | None = None, **members: Any):  # fmt: skip
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
         made = {k: v(tmp) if callable(v) else v for k, v in members.items()}
@@ -264,7 +264,7 @@ def _huge_member(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
     return _evaluate(model, tmp), str(model)
 
 
-def _beside(name: str, content: str, env: str = "SGCRod-v0"):
+def _beside(name: str, content: str, env: str = "SGCRod-v1"):
     """The clean (point) model on another env, with ``name`` written beside it."""
 
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
@@ -294,7 +294,7 @@ MODELS: dict[str, Case] = {
     "data 5000-digit integer": Case(_model(lambda d: b'{"n": ' + b"9" * 5000 + b"}"),
                                     "not valid JSON"),
     "net_arch [8000]*4": Case(_model(_net_arch), "net_arch[0]: 8000 units; at most 4096"),
-    "140 KB Dict space text": Case(_model(_dict_space, env="SGCPointGoal-v0")),
+    "140 KB Dict space text": Case(_model(_dict_space, env="SGCPointGoal-v1")),
     "8 GiB member claimed": Case(_huge_member, "'system_info.txt': 4026531840 bytes; at most"),
     "100 members": Case(_model(**{f"x{i}.txt": b"x" for i in range(100)}), "members; at most"),
     "pytorch_variables __class__": Case(_model(**{"pytorch_variables.pth":
@@ -305,8 +305,8 @@ MODELS: dict[str, Case] = {
     "foreign .pth member": Case(_model(**{"__class__.pth": _torch_variables("x")}),
                                 "not weights SB3 writes"),
     "gains_env of a foreign env": Case(_model(
-        _foreign_gains_env, env="SGCThreeRodsRandom-v2",
-        source=SHIPPED / "ppo_perbody_SGCThreeRodsRandom-v2.zip"), "gains_env must be an SGC"),
+        _foreign_gains_env, env="SGCThreeRodsRandom-v3",
+        source=SHIPPED / "ppo_perbody_SGCThreeRodsRandom-v3.zip"), "gains_env must be an SGC"),
     "escapes in a space dtype": Case(_model(_space_dtype), "does not fit"),
     "escapes in config.json env_id": Case(_beside("config.json", json.dumps({"env_id": ANSI})),
                                           "trained on"),
@@ -335,7 +335,7 @@ def _recipes(content: bytes) -> Callable[[Path, Path], tuple[list[str], str | No
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
         file = tmp / "recipes.yml"
         file.write_bytes(content)
-        return ["benchmark", "--recipes", str(file), "--env", "SGCPoint-v0", "--seeds", "1",
+        return ["benchmark", "--recipes", str(file), "--env", "SGCPoint-v1", "--seeds", "1",
                 "--out", str(tmp / "out"), "--no-plots", "--report-only"], str(file)  # fmt: skip
 
     return build
@@ -345,9 +345,9 @@ def _hyperparams(lines: str, *extra: str) -> Callable[[Path, Path], tuple[list[s
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
         folder = tmp / "hp"
         folder.mkdir()
-        (folder / "ppo.yml").write_text("SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n"
+        (folder / "ppo.yml").write_text("SGCPoint-v1:\n  n_timesteps: 64\n  policy: MlpPolicy\n"
                                         + lines)  # fmt: skip
-        return ["train", "--algo", "ppo", "--env", "SGCPoint-v0", "--timesteps", "64",
+        return ["train", "--algo", "ppo", "--env", "SGCPoint-v1", "--timesteps", "64",
                 "--hyperparams", str(folder), "--out", str(tmp / "out"), *extra], \
             str(folder / "ppo.yml")  # fmt: skip
 
@@ -355,7 +355,7 @@ def _hyperparams(lines: str, *extra: str) -> Callable[[Path, Path], tuple[list[s
 
 
 def _env_kwargs_flag(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
-    return ["train", "--algo", "ppo", "--env", "SGCPoint-v0", "--timesteps", "64",
+    return ["train", "--algo", "ppo", "--env", "SGCPoint-v1", "--timesteps", "64",
             "--env-kwargs", '{"sim_frequency": 10000000}', "--out", str(tmp / "out")], \
         "env_kwargs: sim_frequency"  # fmt: skip
 
@@ -381,22 +381,22 @@ RECIPES: dict[str, Case] = {
 
 def _results(name: str, content: str) -> Callable[[Path, Path], tuple[list[str], str | None]]:
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
-        folder = tmp / "out" / "runs" / "SGCPoint-v0" / "ppo" / "seed0"
+        folder = tmp / "out" / "runs" / "SGCPoint-v1" / "ppo" / "seed0"
         folder.mkdir(parents=True)
         (folder / name).write_text(content)
-        return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "1",
+        return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v1", "--seeds", "1",
                 "--out", str(tmp / "out"), "--report-only", "--no-plots"], str(folder / name)
 
     return build
 
 
-SPEC = {"env_id": "SGCPoint-v0", "seed": 0, "eval_episodes": 50, "test_seed": 20000,
+SPEC = {"env_id": "SGCPoint-v1", "seed": 0, "eval_episodes": 50, "test_seed": 20000,
         "recipe": {"name": "ppo", "algo": "ppo", "demonstrations": False}}  # fmt: skip
 
 
 def _out_is_a_file(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
     (tmp / "out").write_text("not a folder")
-    return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--out", str(tmp / "out"),
+    return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v1", "--out", str(tmp / "out"),
             "--report-only"], str(tmp / "out")  # fmt: skip
 
 
@@ -423,7 +423,7 @@ def _npz(tmp: Path, replace: dict[str, bytes] | None = None, **arrays: Any) -> P
     content = dict(observations=obs, actions=np.zeros((rows, 3), np.float32),
                    rewards=np.zeros(rows, np.float32), terminations=np.zeros(rows, bool),
                    truncations=np.zeros(rows, bool), episode_starts=np.ones(rows, bool),
-                   seeds=np.arange(1), env_id=np.array("SGCPoint-v0"),
+                   seeds=np.arange(1), env_id=np.array("SGCPoint-v1"),
                    env_kwargs=np.array("{}"), pushes=np.array("{}"),
                    format_version=np.array(1))  # fmt: skip
     content.update(arrays)
@@ -437,7 +437,7 @@ def _npz(tmp: Path, replace: dict[str, bytes] | None = None, **arrays: Any) -> P
 def _demos(make: Callable[[Path], Path]) -> Callable[[Path, Path], tuple[list[str], str | None]]:
     def build(tmp: Path, clean: Path) -> tuple[list[str], str | None]:
         file = make(tmp)
-        return ["train", "--algo", "ppo", "--env", "SGCPoint-v0", "--timesteps", "64", "--init",
+        return ["train", "--algo", "ppo", "--env", "SGCPoint-v1", "--timesteps", "64", "--init",
                 "bc", "--demos", str(file), "--out", str(tmp / "out")], str(file)  # fmt: skip
 
     return build
@@ -491,7 +491,7 @@ def clean(tmp_path_factory: pytest.TempPathFactory) -> Path:
     import baselines.figures.plots  # noqa: F401  (imports are not the file's work: done first)
     import sgc_env  # noqa: F401
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     path = tmp_path_factory.mktemp("clean") / "model.zip"
     PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu",
         policy_kwargs={"net_arch": [8]}).save(path)  # fmt: skip

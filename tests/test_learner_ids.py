@@ -13,7 +13,7 @@ from baselines.evaluation.harness import evaluate
 from baselines.policies import make_policy, needs_planner_view
 
 
-@pytest.mark.parametrize("env_id", sgc_env.LEARNER_IDS)
+@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)
 def test_newest_versions_default_to_the_learner_view(env_id: str) -> None:
     env = gym.make(env_id)
     assert env.unwrapped.observation_view == "learner"
@@ -52,8 +52,8 @@ def test_the_expert_reads_the_planner_view_itself() -> None:
 
 
 def test_same_scenes_and_dynamics_as_the_planner_version() -> None:
-    """SGCRod-v1 with observation='planner' and reward='schedule' is SGCRod-v0, bit for bit."""
-    old = gym.make("SGCRod-v0")
+    """SGCRod-v1 with observation='planner' and reward='schedule' is SGCRod-v1, bit for bit."""
+    old = gym.make("SGCRod-v1")
     new = gym.make("SGCRod-v1", observation="planner", reward="schedule")
     a, _ = old.reset(seed=11)
     b, _ = new.reset(seed=11)

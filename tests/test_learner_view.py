@@ -33,7 +33,7 @@ def _records(env_id: str, steps: int, seed: int = 0) -> list[np.ndarray]:
     return out
 
 
-@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0", "SGCThreeRodsRandom-v2"])
+@pytest.mark.parametrize("env_id", ["SGCPoint-v1", "SGCRod-v1", "SGCThreeRodsRandom-v3"])
 def test_view_is_float32_inside_its_bounds(env_id: str) -> None:
     blocks = np.stack(_records(env_id, 120))
     n_bodies = blocks.shape[1]
@@ -53,7 +53,7 @@ def test_on_schedule_entries_match_the_policy_side_extractor() -> None:
     th = pytest.importorskip("torch")
     from baselines.models.schedule_features import ScheduleFeatures
 
-    env = gym.make("SGCRod-v0")
+    env = gym.make("SGCRod-v1")
     obs, _ = env.reset(seed=3)
     rows, views = [], []
     for _ in range(60):
@@ -77,7 +77,7 @@ def test_on_schedule_entries_match_the_policy_side_extractor() -> None:
 def test_goal_preview_points_from_the_body_to_the_nails() -> None:
     """The current goal entry is the nail minus the tracked point (squashed), the next goal's
     the next nail minus the point, with the goal times."""
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     env.reset(seed=5)
     task = env.unwrapped.task
     view = learner_observation(env.unwrapped._block[None], np.zeros((1, 1, 3)), np.zeros(1))[0]

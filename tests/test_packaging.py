@@ -27,22 +27,22 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.mark.parametrize("algo", ["ppo", "sac", "td3", "her"])
 def test_packaged_hyperparams_load_without_a_folder(algo: str) -> None:
     assert hyperparams_file(algo).is_file()
-    env_id = "SGCPointGoal-v0" if algo == "her" else "SGCPoint-v0"
+    env_id = "SGCPointGoal-v1" if algo == "her" else "SGCPoint-v1"
     hp = load_hyperparams(algo, env_id)
     assert hp.env_id == env_id and hp.n_timesteps > 0
 
 
 def test_shipped_models_resolve_and_load() -> None:
     models = shipped_models()
-    assert set(models) <= set(sgc_env.ENV_IDS) and "SGCPoint-v0" in models
-    assert resolve_policy_spec("shipped:SGCPoint-v0") == models["SGCPoint-v0"]
+    assert set(models) <= set(sgc_env.ENV_IDS) and "SGCPoint-v1" in models
+    assert resolve_policy_spec("shipped:SGCPoint-v1") == models["SGCPoint-v1"]
     for stem, path in shipped_files().items():
         assert resolve_policy_spec(f"shipped:{stem}") == path
-    assert "ppo_schedule_SGCPoint-v0" in shipped_files()  # the model learned without demos
+    assert "ppo_schedule_SGCPoint-v1" in shipped_files()  # the model learned without demos
     assert resolve_policy_spec("expert") == "expert"
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     obs, _ = env.reset(seed=0)
-    action, _ = make_policy("shipped:SGCPoint-v0", env).predict(obs)
+    action, _ = make_policy("shipped:SGCPoint-v1", env).predict(obs)
     assert env.action_space.contains(action.astype(env.action_space.dtype))
     with pytest.raises(ValueError, match="no shipped model 'shipped:Nope-v0'"):
         resolve_policy_spec("shipped:Nope-v0")

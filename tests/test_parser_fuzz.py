@@ -106,7 +106,7 @@ def test_policy_kwargs_strings(text: str) -> None:
 def _hyperparams(folder: Path) -> Any:
     from baselines.agents.hyperparams import load_hyperparams
 
-    return load_hyperparams("ppo", "SGCPoint-v0", folder)
+    return load_hyperparams("ppo", "SGCPoint-v1", folder)
 
 
 def _recipes(folder: Path) -> Any:
@@ -117,7 +117,7 @@ def _recipes(folder: Path) -> Any:
 
 #: An rl-zoo3 YAML reader -> the file it reads (``ppo.yml`` in a folder) as a valid text.
 YAML_FILES = {
-    _hyperparams: "SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_envs: 2\n",
+    _hyperparams: "SGCPoint-v1:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_envs: 2\n",
     _recipes: "recipes:\n  - {name: a, algo: ppo, timesteps: 64}\n",
 }
 
@@ -141,7 +141,7 @@ def point_env() -> Any:
     pytest.importorskip("stable_baselines3")
     import sgc_env  # noqa: F401
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     yield env
     env.close()
 
@@ -221,7 +221,7 @@ def test_demonstration_npz_bytes(edits: list[tuple[int, int]], tmp_path: Path) -
     buffer = io.BytesIO()
     np.savez(buffer, observations=rows, actions=rows[:, :3], rewards=rows[:, 0],
              terminations=rows[:, 0] > 0, truncations=rows[:, 0] > 0,
-             episode_starts=rows[:, 0] == 0, seeds=np.arange(1), env_id=np.array("SGCPoint-v0"),
+             episode_starts=rows[:, 0] == 0, seeds=np.arange(1), env_id=np.array("SGCPoint-v1"),
              env_kwargs=np.array("{}"), pushes=np.array("{}"), format_version=np.array(1))
     path.write_bytes(_mutate(buffer.getvalue(), edits))
     try:
@@ -237,7 +237,7 @@ def test_benchmark_results(record: Any, tmp_path: Path) -> None:
     from baselines.benchmark.grid import Recipe, RunSpec
     from baselines.benchmark.results import read_record
 
-    spec = RunSpec(Recipe("ppo", "ppo"), "SGCPoint-v0", 0, 0, 1, 1)
+    spec = RunSpec(Recipe("ppo", "ppo"), "SGCPoint-v1", 0, 0, 1, 1)
     path = tmp_path / "result.json"
     if isinstance(record, dict):
         record = {"spec": spec.to_dict(), **record}

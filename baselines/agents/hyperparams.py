@@ -17,7 +17,7 @@ from typing import Any
 
 from baselines.common.network_caps import check_policy_kwargs
 from baselines.common.shipped import hyperparams_file
-from baselines.common.value_types import check_weight, describe, matches
+from baselines.common.value_types import describe, matches
 from baselines.models.features import ACTIVATIONS
 from sgc_env.scenario.bounded import check_count, escaped, load_yaml, read_text
 
@@ -33,8 +33,7 @@ __all__ = [
 
 _NAME_PREFIXES = ("nn.", "th.nn.", "torch.nn.")
 _STRING_KWARGS = ("policy_kwargs", "replay_buffer_kwargs")
-_ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std",
-             "reward_shaping", "action_rate"}  # fmt: skip
+_ZOO_KEYS = {"n_timesteps", "policy", "n_envs", "normalize", "noise_type", "noise_std"}
 
 
 @dataclass
@@ -52,8 +51,6 @@ class Hyperparams:
     noise_std: float = 0.1
     algo_kwargs: dict[str, Any] = field(default_factory=dict)
     raw: dict[str, Any] = field(default_factory=dict)
-    reward_shaping: str = "none"  # training envs only (baselines/agents/shaping.py)
-    action_rate: float = 0.0  # training envs only (baselines/agents/action_rate.py)
 
 
 def _resolve_name(dotted: str, field_name: str) -> Any:
@@ -70,10 +67,6 @@ def _resolve_name(dotted: str, field_name: str) -> Any:
         from baselines.models.features import StandardizeObservation
 
         return StandardizeObservation
-    if short == "ScheduleFeatures":
-        from baselines.models.schedule_features import ScheduleFeatures
-
-        return ScheduleFeatures
     if short == "LearnerViewBodies":
         from baselines.models.per_body import LearnerViewBodies
 
@@ -285,19 +278,9 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         n_timesteps = int(float(entry["n_timesteps"]))
         n_envs = int(entry.get("n_envs", 1))
         noise_std = float(entry.get("noise_std", 0.1))
-        action_rate = float(entry.get("action_rate", 0.0))
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs, noise_std and action_rate "
-                         "must be finite numbers") from None  # fmt: skip
-    try:
-        check_weight(action_rate, "action_rate")
-    except ValueError as exc:
-        raise ValueError(f"{path}: {env_id}: {exc}") from None
-    shaping = entry.get("reward_shaping", "none")
-    if shaping not in ("none", "smooth", "smooth_alive"):
-        raise ValueError(f"{path}: {env_id}: reward_shaping must be 'none', 'smooth' or "
-                         f"'smooth_alive', "
-                         f"got {shaping!r}")  # fmt: skip
+        raise ValueError(f"{path}: {env_id}: n_timesteps, n_envs and noise_std must be finite "
+                         "numbers") from None  # fmt: skip
     if not isinstance(entry["policy"], str):
         raise ValueError(f"{path}: {env_id}: policy must be a name such as MlpPolicy")
     if n_envs < 1:
@@ -315,6 +298,4 @@ def load_hyperparams(algo: str, env_id: str, directory: str | Path | None = None
         noise_std=noise_std,
         algo_kwargs=kwargs,
         raw=dict(entry),
-        reward_shaping=shaping,
-        action_rate=action_rate,
     )

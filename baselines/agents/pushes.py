@@ -1,6 +1,6 @@
 """Random pushes during demonstrations and DAgger rollouts, for state diversity.
 
-On a fixed scene (``SGCIntercept-v0``, ``SGCThreeRods-v1``) every reset gives the same
+On a fixed scene (``SGCIntercept-v1``, ``SGCThreeRods-v2``) every reset gives the same
 scenario, so every expert demonstration is the same trajectory and a clone never sees a state
 off it. A push (:meth:`SGCEnv.apply_impulse`) knocks a body off course between two ticks; the
 expert re-plans from any state, so its actions after a push are the recovery a clone needs to

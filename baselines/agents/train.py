@@ -174,14 +174,6 @@ def train(cfg: TrainConfig, hp: Hyperparams | None = None) -> TrainResult:
     total = hp.n_timesteps if cfg.timesteps is None else int(cfg.timesteps)
     set_random_seed(cfg.seed)
     env = _make_env(cfg.env_id, hp.n_envs, cfg.seed, cfg.env_kwargs, cfg.vec)
-    if hp.reward_shaping != "none":
-        from baselines.agents.shaping import SmoothScheduleCost
-
-        env = SmoothScheduleCost(env, alive=hp.reward_shaping == "smooth_alive")
-    if hp.action_rate:
-        from baselines.agents.action_rate import ActionRatePenalty
-
-        env = ActionRatePenalty(env, hp.action_rate)
     if hp.normalize:
         # rl-zoo3's rule: the reward's running return uses the algorithm's gamma unless the
         # file's normalize gives its own

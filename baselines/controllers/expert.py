@@ -86,7 +86,7 @@ class SGCExpert:
         ``refine``: give the torque between goals its correction step on the simulated
         rotation (goal ticks, and every tick under ``"smooth"``, get the exact Newton).
 
-        Measured on SGCRod-v0 and the three-rod demo: the closed-form first guess alone
+        Measured on SGCRod-v1 and the three-rod demo: the closed-form first guess alone
         misses the planned rotation by ~1e-6 rad per tick (median; up to 1e-4 on a thin rod's
         somersault, whose tiny axial inertia makes the torque's effect depend on the path the
         axis takes), the corrected torque by ~1e-8 (up to 1e-5). Re-planning every tick

@@ -58,7 +58,7 @@ reference's planned kink on that track."""
 BEND = 0.5
 """Largest change of the reference's velocity over a sub-course, as a fraction of its average
 velocity: beyond it the course bends too much for an SGC course re-solved from a measured
-state mid-way (measured on SGCThreeRodsRandom-v2 seed 10000's second rod, a turn at about
+state mid-way (measured on SGCThreeRodsRandom-v3 seed 10000's second rod, a turn at about
 1.2 rad/s reversing within 8 ticks: 61.8 rad/s² of kink, 4.3x minimum jerk's, without this
 limit; 13.2 with it)."""
 

@@ -1,6 +1,6 @@
 """The paper's three-rod demo, flown by a policy and written out as a viewer would want it.
 
-One episode of ``SGCThreeRods-v1`` driven by :class:`baselines.SGCExpert` (the tangent
+One episode of ``SGCThreeRods-v2`` driven by :class:`baselines.SGCExpert` (the tangent
 end-velocity rule by default, the paper's eqs. 12-14 with ``end_rule="paper"``) or by any
 policy spec :func:`baselines.policies.make_policy` accepts (``DemoOptions.policy``), scored by
 the shared harness, and rendered headless through the renderer of ``env.render()``
@@ -43,7 +43,7 @@ __all__ = [
     "pierce_times", "run_demo",
 ]  # fmt: skip
 
-ENV_ID = "SGCThreeRods-v1"
+ENV_ID = "SGCThreeRods-v2"
 """The paper's scene with the planner's view: the expert and the hand-written controllers fly it."""
 LEARNER_ENV_ID = "SGCThreeRods-v2"
 """The same scene with the learner's view: models trained on the newest ids fly it."""

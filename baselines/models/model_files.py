@@ -37,7 +37,7 @@ from sgc_env.scenario.bounded import (
 from sgc_env.scenario.caps import cap
 
 __all__ = [
-    "MOVED_MODULES",
+    "EARLIER_MODULES",
     "ModelFileError",
     "TRUST_WARNING",
     "algorithm_from_data",
@@ -63,15 +63,6 @@ _RUNTIME_STATE = ("_last_obs", "_last_original_obs", "_last_episode_starts", "ep
 _SCHEDULES = ("lr_schedule", "learning_rate", "clip_range", "clip_range_vf")
 _CLASS_FIELDS = ("policy_class", "rollout_buffer_class", "replay_buffer_class")
 _KWARGS_FIELDS = ("policy_kwargs", "rollout_buffer_kwargs", "replay_buffer_kwargs")
-#: Modules of this project's model classes in files saved before they moved (the shipped
-#: models name them): old module -> today's, so those files still load.
-MOVED_MODULES = {
-    "baselines.agents.features": "baselines.models.features",  # old path
-    "baselines.agents.schedule_features": "baselines.models.schedule_features",  # old path
-    "baselines.agents.per_body": "baselines.models.per_body",  # old path
-}
-
-
 class ModelFileError(ValueError):
     """A model file that is malformed, does not fit the env, or would need unpickling."""
 
@@ -87,7 +78,6 @@ def allowed_classes() -> dict[str, type]:
 
     from baselines.models.features import ACTIVATIONS, StandardizeObservation
     from baselines.models.per_body import LearnerViewBodies, PerBodyPolicy
-    from baselines.models.schedule_features import ScheduleFeatures
 
     classes: list[type] = [
         policies.ActorCriticPolicy, policies.ActorCriticCnnPolicy,
@@ -95,16 +85,13 @@ def allowed_classes() -> dict[str, type]:
         sac.MultiInputPolicy,
         td3.TD3Policy, td3.CnnPolicy, td3.MultiInputPolicy,
         torch_layers.FlattenExtractor, torch_layers.NatureCNN, torch_layers.CombinedExtractor,
-        StandardizeObservation, ScheduleFeatures, LearnerViewBodies,
+        StandardizeObservation, LearnerViewBodies,
         *(getattr(th.nn, name) for name in ACTIVATIONS),
         th.optim.Adam, th.optim.AdamW, th.optim.RMSprop, th.optim.SGD,
         buffers.RolloutBuffer, buffers.DictRolloutBuffer, buffers.ReplayBuffer,
         buffers.DictReplayBuffer, HerReplayBuffer,
     ]  # fmt: skip
-    named = {f"{c.__module__}.{c.__qualname__}": c for c in classes}
-    moved = {f"{old}.{c.__qualname__}": c for old, new in MOVED_MODULES.items()
-             for c in classes if c.__module__ == new}  # fmt: skip
-    return named | moved
+    return {f"{c.__module__}.{c.__qualname__}": c for c in classes}
 
 
 def _fail(path: str, problem: str) -> ModelFileError:
@@ -230,8 +217,18 @@ def _pickled(value: Any) -> bool:
     return isinstance(value, dict) and ":serialized:" in value
 
 
+#: Modules that held this project's model classes before 1.0 (the features computed inside the
+#: policy for the planner's view): a file naming one is a model of an earlier id.
+EARLIER_MODULES = ("baselines.agents.features", "baselines.agents.schedule_features",
+                   "baselines.agents.per_body", "baselines.models.schedule_features")  # fmt: skip
+
+
 def _named_class(dotted: str, where: str, path: str) -> type:
     cls = allowed_classes().get(dotted)
+    if cls is None and dotted.rpartition(".")[0] in EARLIER_MODULES:
+        raise _fail(path, f"{where} names class {dotted!r} of sgc before 1.0, a model of an "
+                          "earlier env version; train a new one on the current id (CHANGELOG.md, "
+                          "'Migrating to 1.0')")  # fmt: skip
     if cls is None:
         raise _fail(path, f"{where} names class {dotted!r}, which is not on the allow-list of "
                           "this project's and SB3's classes; load it with --trust-model only if "

@@ -5,15 +5,13 @@ the same per-body block, so the three-rod problem is three copies of one 6-D pro
 :class:`PerBodyPolicy` maps each body's slice of the features through the same MLP to that
 body's 6-D action and concatenates the actions. The features are the env's own learner view
 (:class:`LearnerViewBodies`: the body's two tracks of the view, 23 entries each, and the
-episode's time fraction) or, on a planner-view id, the features computed inside the policy
-(:class:`~baselines.models.schedule_features.ScheduleFeatures`, 16 per track); the
-critic averages per-body values (the env's reward is a mean over bodies). Three bodies give
-three samples of the shared net per env step, and the same weights run on any number of
-bodies.
+episode's time fraction); the critic averages per-body values (the env's reward is a mean
+over bodies). Three bodies give three samples of the shared net per env step, and the same
+weights run on any number of bodies.
 
 **Actions in acceleration units.** The net's output is a desired acceleration in units of
 ``REFERENCE_ACCELERATION`` (m/s^2 for the force, rad/s^2 for the torque; the action scale of
-``SGCRod-v0``, where the gain is ~1), which a fixed per-body gain turns into the env's action,
+``SGCRod-v1``, where the gain is ~1), which a fixed per-body gain turns into the env's action,
 plus the action that holds the body against gravity. Why: the action scale differs between
 scenes (``SGCThreeRodsRandom`` has twice the paper scene's force and torque limits, the rod
 preset a third of its angular acceleration), the agent does not observe the limits, and a net
@@ -41,7 +39,6 @@ from stable_baselines3.common.type_aliases import PyTorchObs
 from torch import nn
 
 from baselines.common.env_model import EnvModel
-from baselines.models.schedule_features import TRACK_FEATURES, ScheduleFeatures
 from sgc_env.envs.learner_view import LEARNER_BODY_SIZE, LEARNER_TRACK_SIZE, learner_size
 from sgc_env.scenario.bounded import escaped
 
@@ -57,13 +54,10 @@ __all__ = [
 BODY_ACTIONS = 6
 _SGC_ID = re.compile(r"SGC[A-Za-z0-9]{1,60}-v\d{1,4}")
 """The ids ``gains_env`` may name: this package's (registered or renamed), no other env's."""
-BODY_FEATURES = 2 * TRACK_FEATURES
-"""What the shared net reads of each body from :class:`ScheduleFeatures`: the two tracks'
-features (its gravity column is dropped: the hover is in the action map)."""
-LEARNER_BODY_FEATURES = 2 * LEARNER_TRACK_SIZE + 1
+BODY_FEATURES = 2 * LEARNER_TRACK_SIZE + 1
 """What the shared net reads of each body from :class:`LearnerViewBodies`."""
 REFERENCE_ACCELERATION = 100.0
-"""m/s^2 and rad/s^2 per unit of the net's output (SGCRod-v0's own action scale)."""
+"""m/s^2 and rad/s^2 per unit of the net's output (SGCRod-v1's own action scale)."""
 
 
 def body_gains(env: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -109,7 +103,7 @@ class LearnerViewBodies(BaseFeaturesExtractor):
                 f"LearnerViewBodies needs the learner view (n * {LEARNER_BODY_SIZE} + 1 "
                 f"entries), got {observation_space}"
             )
-        super().__init__(observation_space, n_bodies * LEARNER_BODY_FEATURES)
+        super().__init__(observation_space, n_bodies * BODY_FEATURES)
         self.n_bodies = n_bodies
 
     def forward(self, observations: th.Tensor) -> th.Tensor:
@@ -119,10 +113,7 @@ class LearnerViewBodies(BaseFeaturesExtractor):
         return th.cat([bodies[..., : 2 * LEARNER_TRACK_SIZE], clock], dim=-1).flatten(1)
 
 
-_BODY_INPUTS: dict[type, tuple[int, int]] = {
-    ScheduleFeatures: (BODY_FEATURES + 1, BODY_FEATURES),
-    LearnerViewBodies: (LEARNER_BODY_FEATURES, LEARNER_BODY_FEATURES),
-}
+_BODY_INPUTS: dict[type, tuple[int, int]] = {LearnerViewBodies: (BODY_FEATURES, BODY_FEATURES)}
 """Per features extractor: the features per body it hands out, and how many the net reads."""
 
 
@@ -198,10 +189,9 @@ class PerBodyPolicy(ActorCriticPolicy):
     """:class:`ActorCriticPolicy` with one shared net per body (module docstring).
 
     ``gains_env``: the env id whose bodies set the action gains at construction (None: gain 1,
-    no hover, ``SGCRod-v0``'s scale without gravity); ``bind_env`` resets them for another env.
+    no hover, ``SGCRod-v1``'s scale without gravity); ``bind_env`` resets them for another env.
     ``skip``: the action head reads the body's features beside the last hidden layer.
-    The features extractor is :class:`ScheduleFeatures` (the default: planner-view ids) or
-    :class:`LearnerViewBodies` (the learner view of the newest ids). The action
+    The features extractor is :class:`LearnerViewBodies` (the env's learner view). The action
     noise's log std is shared per action component across bodies (6 parameters) and, like the
     mean, in acceleration units (``log_std_init=-3``: 5 m/s^2 and 5 rad/s^2 on every scene).
     """
@@ -216,10 +206,9 @@ class PerBodyPolicy(ActorCriticPolicy):
         skip: bool = False,
         **kwargs: Any,
     ) -> None:
-        kwargs.setdefault("features_extractor_class", ScheduleFeatures)
+        kwargs.setdefault("features_extractor_class", LearnerViewBodies)
         if kwargs["features_extractor_class"] not in _BODY_INPUTS:
-            raise ValueError("PerBodyPolicy: features_extractor_class must be ScheduleFeatures "
-                             "or LearnerViewBodies")  # fmt: skip
+            raise ValueError("PerBodyPolicy: features_extractor_class must be LearnerViewBodies")
         if kwargs.get("use_sde"):
             raise ValueError("PerBodyPolicy: use_sde is not supported")
         self.gains_env = gains_env

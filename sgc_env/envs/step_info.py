@@ -92,7 +92,7 @@ class StepInfo(_StepInfoEveryStep, total=False):
     one row per body; ``goal_reached`` only on a tick where goals fall."""
 
     goal_reached: list[GoalEvent]
-    failure_charge: float  # SGCPointGoal-v0 on a failed step: the steps it did not get to
+    failure_charge: float  # SGCPointGoal-v1 on a failed step: the steps it did not get to
 
 
 def step_info(

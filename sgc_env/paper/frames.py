@@ -43,7 +43,7 @@ use ``rho``, and its cone of realisable directions is wider: between two courses
 speed it is realised up to a turn of about 86 degrees (every component of ``S_i`` keeps at
 least ``k_min`` of its average), where the paper's own rule already needs its ``rho <= 0``
 extension beyond 54.7 degrees. So a turn beyond pi/6 alone does not make it fall back
-(``within_paper_assumption`` still reports it): falling back there too measured SGCRod-v0's
+(``within_paper_assumption`` still reports it): falling back there too measured SGCRod-v1's
 whole-track SPARC back at the paper's (-2.42 against -2.22, seeds 10000-10009).
 
 A change of pace is graded: the mean is clamped to between ``1 / PACE_STEP`` and

@@ -4,7 +4,7 @@ state drawn from the env's ``np_random`` on every reset.
 A sphere (the "bird") starts at a drawn position and velocity, passes a drawn intermediate
 nail (timed by routing) and must meet a kinematic target (the "fish", a piecewise-linear
 path) at a drawn meeting time. Body, prop and limits are those of ``intercept.yaml``, so the
-observation and action spaces are those of ``SGCIntercept-v0`` for every draw.
+observation and action spaces are those of ``SGCIntercept-v1`` for every draw.
 
 Feasibility: a draw is kept only if the analytic plan (``demand_bounds``, evaluated per
 course: a few milliseconds) needs at most ``demand_share`` of the force limit; otherwise the

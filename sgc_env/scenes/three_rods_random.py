@@ -5,7 +5,7 @@ Each rod's path is the cubic spline through the paper's waypoints moved by drawn
 (the hit point stays on the target face); the goal counts before and after the ball, the
 pierce and hit times, the balls' velocities and where the teal rod turns its somersault are
 drawn too. Rods, balls and the target board keep their geometry, so the observation and action
-spaces are those of ``SGCThreeRods-v1`` for every draw; the limits are constants of the id
+spaces are those of ``SGCThreeRods-v2`` for every draw; the limits are constants of the id
 (twice the paper scene's).
 
 Feasibility: a rod is kept only if a planner-free bound of the force and torque its analytic

@@ -45,7 +45,7 @@ def test_exports_are_the_classes():
     assert MinimumJerkController.__module__ == "baselines.controllers.comparison_policies"
 
 
-@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0"])
+@pytest.mark.parametrize("env_id", ["SGCPoint-v1", "SGCRod-v1"])
 def test_episode_expert_exact_on_redrawn_scenarios(env_id):
     """Seed 3 redraws force limits: the plain expert's construction-time model goes stale."""
     env = gym.make(env_id)
@@ -54,19 +54,19 @@ def test_episode_expert_exact_on_redrawn_scenarios(env_id):
     for seed in (3, 4):
         _, _, _, card = _rollout(env, policy, seed)
         assert card["position_error_max"] <= 1e-8
-        if env_id == "SGCRod-v0":
+        if env_id == "SGCRod-v1":
             assert card["orientation_error_max"] <= 1e-8
     env.close()
 
 
-@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0"])
+@pytest.mark.parametrize("env_id", ["SGCPoint-v1", "SGCRod-v1"])
 def test_minimum_jerk_meets_goals_with_continuous_velocity(env_id):
     env = gym.make(env_id)
     policy = MinimumJerkController(env)
     for seed in (0, 5):
         infos, _, goals, card = _rollout(env, policy, seed)
         assert card["position_error_max"] <= 1e-6
-        if env_id == "SGCRod-v0":
+        if env_id == "SGCRod-v1":
             assert card["orientation_error_max"] <= 1e-6
         assert card["success_rate"] == 1.0
         # Velocity continuity: the step across a goal changes the velocity no more than
@@ -79,7 +79,7 @@ def test_minimum_jerk_meets_goals_with_continuous_velocity(env_id):
 
 
 def test_minimum_jerk_one_spline_per_sub_env():
-    envs = gym.vector.SyncVectorEnv([lambda: gym.make("SGCPoint-v0")] * 2)
+    envs = gym.vector.SyncVectorEnv([lambda: gym.make("SGCPoint-v1")] * 2)
     policy = MinimumJerkController(envs)
     obs, _ = envs.reset(seed=[11, 12])
     errors = []
@@ -99,7 +99,7 @@ def test_minimum_jerk_one_spline_per_sub_env():
     assert max(errors) <= 1e-6
 
 
-@pytest.mark.parametrize(("source", "seed"), [("point_three_goals", 0), ("SGCPoint-v0", 2)])
+@pytest.mark.parametrize(("source", "seed"), [("point_three_goals", 0), ("SGCPoint-v1", 2)])
 def test_dynamic_constraints_shows_figure1_pathology(source, seed):
     """Figure 1: goals met early or late with the body nearly stopped, never at t_i."""
     env = gym.make(source) if source.startswith("SGC") else SGCEnv(scenario=source)
@@ -122,7 +122,7 @@ def test_dynamic_constraints_shows_figure1_pathology(source, seed):
 
 
 def test_dynamic_constraints_rejects_bad_eps():
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     with pytest.raises(ValueError, match="eps"):
         DynamicConstraintsController(env, eps=0.0)
     env.close()
@@ -137,18 +137,18 @@ def test_random_policy_is_seeded_and_inside_the_space():
 
 
 def test_make_policy_errors(tmp_path):
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     with pytest.raises(ValueError, match="policy: unknown spec 'nope'"):
         make_policy("nope", env)
     with pytest.raises(ValueError, match="does not exist"):
         make_policy(str(tmp_path / "missing.zip"), env)
     env.close()
-    goal_env = gym.make("SGCPointGoal-v0")
+    goal_env = gym.make("SGCPointGoal-v1")
     assert isinstance(make_policy("random", goal_env, seed=0), RandomPolicy)
     goal_env.close()
 
 
-@pytest.mark.parametrize("env_id", ["SGCPointGoal-v0", "SGCPointGoal-v1"])
+@pytest.mark.parametrize("env_id", ["SGCPointGoal-v1", "SGCPointGoal-v1"])
 @pytest.mark.parametrize("spec", ["expert", "minimum-jerk", "dynamic-constraints"])
 def test_the_planner_policies_read_a_goal_envs_dict(env_id, spec):
     """Through the ``observation`` entry (the planner's view) or the env's planner view (the
@@ -156,7 +156,7 @@ def test_the_planner_policies_read_a_goal_envs_dict(env_id, spec):
     the flat id."""
     env = gym.make(env_id)
     record = run_episode(make_policy(spec, env), env, seed=3)
-    flat = gym.make("SGCPoint-v0")
+    flat = gym.make("SGCPoint-v1")
     expected = run_episode(make_policy(spec, flat), flat, seed=3)
     assert record.card["success_rate"] == expected.card["success_rate"]
     assert record.card["position_error_max"] == expected.card["position_error_max"]
@@ -190,12 +190,12 @@ def test_models_trained_behind_vecnormalize_get_their_statistics(tmp_path, model
 
     from baselines.models.normalization import save_statistics
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     ppo = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")
     ppo.save(tmp_path / model)
     plain = make_policy(str(tmp_path / model), env)
     assert vecnormalize_path(tmp_path / model) is None and not isinstance(plain, NormalizedPolicy)
-    normalizer = VecNormalize(DummyVecEnv([lambda: gym.make("SGCPoint-v0")]), norm_reward=False)
+    normalizer = VecNormalize(DummyVecEnv([lambda: gym.make("SGCPoint-v1")]), norm_reward=False)
     normalizer.obs_rms.mean[:] = 3.0
     normalizer.obs_rms.var[:] = 4.0
     save_statistics(normalizer, tmp_path / stats)
@@ -245,7 +245,7 @@ def test_every_policy_kind_satisfies_the_policy_protocol():
 
     from baselines.policies import Policy
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     obs, _ = env.reset(seed=0)
     policies = {spec: make_policy(spec, env, seed=0) for spec in BUILTIN_POLICIES}
     policies["SGCExpert"] = SGCExpert(env)

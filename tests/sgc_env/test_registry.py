@@ -53,7 +53,7 @@ def test_random_bound_is_reached_by_the_slowest_draws() -> None:
     assert bound - 3 <= min(steps) and max(steps) <= bound
 
 
-@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0"])
+@pytest.mark.parametrize("env_id", ["SGCRod-v1", "SGCIntercept-v1"])
 def test_time_aware_observation_runs_to_the_env_own_truncation(env_id: str) -> None:
     env = TimeAwareObservation(gym.make(env_id))
     expert = SGCExpert(env)
@@ -80,7 +80,7 @@ def test_sb3_checker_passes_on_the_made_env(env_id: str) -> None:
         # Gymnasium notes that an id has a newer version (the learner's view): not a defect
         warnings.filterwarnings("ignore", ".*is out of date", DeprecationWarning)
         env = gym.make(env_id)
-        if env_id == "SGCPointGoal-v0":
+        if env_id == "SGCPointGoal-v1":
             assert callable(env.get_wrapper_attr("compute_reward"))
             sb3_check_env(env.unwrapped)
         else:
@@ -91,7 +91,7 @@ def test_sb3_checker_passes_on_the_made_env(env_id: str) -> None:
 def test_a_longer_episode_than_the_registered_limit_is_refused() -> None:
     """A scenario the registry's TimeLimit would cut short is an error, not a silent cut."""
     kwargs = {"scenario": "point_three_goals", "control_frequency": 240}
-    env = gym.make("SGCPoint-v0", **kwargs)
+    env = gym.make("SGCPoint-v1", **kwargs)
     with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
         env.reset(seed=0)
     env.close()
@@ -103,11 +103,11 @@ def test_a_longer_episode_than_the_registered_limit_is_refused() -> None:
     direct.close()
     for steps in (-1, 420, 100):
         vec = gym.make_vec(
-            "SGCPoint-v0", 2, "vector_entry_point", max_episode_steps=steps, **kwargs
+            "SGCPoint-v1", 2, "vector_entry_point", max_episode_steps=steps, **kwargs
         )
         vec.reset(seed=0)
         vec.close()
-    vec = gym.make_vec("SGCPoint-v0", 2, "vector_entry_point", **kwargs)
+    vec = gym.make_vec("SGCPoint-v1", 2, "vector_entry_point", **kwargs)
     with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
         vec.reset(seed=0)
     vec.close()

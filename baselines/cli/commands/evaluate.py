@@ -41,7 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--env", action="append", metavar="ID",
         help="environment id, repeat or comma-separate; 'all' = every flat-observation SGC "
-        "id (default: SGCPoint-v0)",
+        "id (default: SGCPoint-v1)",
     )  # fmt: skip
     parser.add_argument(
         "--episodes", type=positive_int, default=5, help="episodes per pair"
@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         policies = _split(args.policy, "expert")
         labels = policy_labels(policies)
-        envs = expand_envs(_split(args.env, "SGCPoint-v0"))
+        envs = expand_envs(_split(args.env, "SGCPoint-v1"))
         tolerances = Tolerances(
             args.tolerance_position, args.tolerance_orientation, args.tolerance_time
         )

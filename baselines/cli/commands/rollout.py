@@ -68,7 +68,7 @@ def make_env(scenario: str | None, env_id: str | None, render: bool) -> tuple[An
     if scenario is not None:
         loaded = sgc_env.load_scenario(scenario)
         return SGCEnv(scenario=loaded, render_mode=mode), escaped(loaded.name, 80)
-    env_id = env_id or "SGCPoint-v0"
+    env_id = env_id or "SGCPoint-v1"
     sgc_env.check_env_id(env_id, "env")
     return gym.make(env_id, render_mode=mode), env_id
 
@@ -84,7 +84,7 @@ def default_out(args: argparse.Namespace, label: str) -> Path:
     """``runs/rollout/<scenario or env>/<policy>``, from the command line only: a scenario
     file's stem (its ``name`` field could be ``../..`` or absolute), a built-in name or an
     env id."""
-    source = Path(args.scenario).stem if args.scenario else (args.env or "SGCPoint-v0")
+    source = Path(args.scenario).stem if args.scenario else (args.env or "SGCPoint-v1")
     return Path("runs/rollout") / folder_name(source) / folder_name(label)
 
 

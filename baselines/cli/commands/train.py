@@ -27,7 +27,7 @@ ALGOS = ("ppo", "sac", "td3", "her")
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--algo", required=True, choices=ALGOS, help="her = SAC + HerReplayBuffer")
-    parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v0")
+    parser.add_argument("--env", required=True, help="registered id, e.g. SGCPoint-v1")
     parser.add_argument("--seed", type=nonneg_int, default=0, help="training seed")
     parser.add_argument(
         "--timesteps", type=nonneg_int, default=None,

@@ -32,7 +32,7 @@ TINY_PPO = {"n_timesteps": 128, "policy": "MlpPolicy", "n_envs": 2, "n_steps": 3
 
 @pytest.fixture()
 def tiny_hp(tmp_path: Path) -> Path:
-    (tmp_path / "ppo.yml").write_text(yaml.safe_dump({"SGCPoint-v0": TINY_PPO}))
+    (tmp_path / "ppo.yml").write_text(yaml.safe_dump({"SGCPoint-v1": TINY_PPO}))
     return tmp_path
 
 
@@ -49,16 +49,16 @@ def test_train_refuses_a_bad_budget_and_two_curve_schedules() -> None:
     from baselines.agents.train import TrainConfig, train
 
     with pytest.raises(ValueError, match="time_budget_s"):
-        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", time_budget_s=-1.0))
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", time_budget_s=-1.0))
     with pytest.raises(ValueError, match="not both"):
-        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", eval_freq=10, eval_every_s=1.0))
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", eval_freq=10, eval_every_s=1.0))
 
 
 def test_the_budget_stops_a_short_learn(tmp_path: Path, tiny_hp: Path) -> None:
     from baselines.agents.train import TrainConfig, train
 
     result = train(TrainConfig(
-        algo="ppo", env_id="SGCPoint-v0", timesteps=10_000_000, hyperparams_dir=tiny_hp,
+        algo="ppo", env_id="SGCPoint-v1", timesteps=10_000_000, hyperparams_dir=tiny_hp,
         time_budget_s=1.0, eval_every_s=0.6, eval_episodes=1, out=tmp_path / "run",
     ))  # fmt: skip
     config = json.loads((tmp_path / "run" / "config.json").read_text())
@@ -75,21 +75,21 @@ def test_the_budget_stops_a_short_learn(tmp_path: Path, tiny_hp: Path) -> None:
 def test_without_a_budget_the_steps_bound_the_run(tiny_hp: Path) -> None:
     from baselines.agents.train import TrainConfig, train
 
-    result = train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", timesteps=64,
+    result = train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", timesteps=64,
                                hyperparams_dir=tiny_hp, time_budget_s=600.0))  # fmt: skip
     assert result.timesteps == 64 and result.config["budget_spent"] is False
 
 
 def test_sgc_train_refuses_a_bad_budget(capsys: pytest.CaptureFixture[str]) -> None:
     for bad in ("0", "-5", "inf", "nan", "soon"):
-        assert cli.main(["train", "--algo", "ppo", "--env", "SGCPoint-v0",
+        assert cli.main(["train", "--algo", "ppo", "--env", "SGCPoint-v1",
                          "--time-budget", bad]) == 2  # fmt: skip
         assert "--time-budget" in capsys.readouterr().err
 
 
 def test_recipe_budget_reaches_the_train_command(tmp_path: Path, tiny_hp: Path) -> None:
     (recipe,) = recipes_from_algos(["ppo"], str(tiny_hp), time_budget_s=120)
-    (spec,) = build_grid([recipe], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+    (spec,) = build_grid([recipe], ["SGCPoint-v1"], [0], eval_freq=0, curve_episodes=1,
                          eval_episodes=2)  # fmt: skip
     assert "--time-budget 120" in train_command(spec.train_options(out="DIR"))
     bad = tmp_path / "recipes.yml"
@@ -107,7 +107,7 @@ def test_budget_recipes_share_one_budget_per_env() -> None:
         for env_id in recipe.envs:
             base = env_id.replace("Goal", "")  # the time-carrying point counts as the point
             budgets.setdefault(base, set()).add(recipe.time_budget_s)  # type: ignore[arg-type]
-    assert set(budgets) >= {"SGCPoint-v0", "SGCRod-v0"}
+    assert set(budgets) >= {"SGCPoint-v1", "SGCRod-v1"}
     assert all(len(b) == 1 for b in budgets.values()), budgets
     assert {r.algo for r in recipes} >= {"ppo", "sac", "td3", "her"}
 
@@ -117,7 +117,7 @@ def test_budget_recipes_share_one_budget_per_env() -> None:
 
 def _fake_run(seed: int, steps: int, curve: list[tuple[int, float, float]]) -> dict[str, Any]:
     (recipe,) = recipes_from_algos(["sac"], time_budget_s=300)
-    (spec,) = build_grid([recipe], ["SGCRod-v0"], [seed], eval_freq=0, curve_episodes=1,
+    (spec,) = build_grid([recipe], ["SGCRod-v1"], [seed], eval_freq=0, curve_episodes=1,
                          eval_episodes=2)  # fmt: skip
     score = {"success_rate": curve[-1][2]}
     return {
@@ -159,9 +159,9 @@ def test_leaderboard_shows_budget_steps_reached_and_both_curves(tmp_path: Path) 
     assert "budget / run (s)" in text and "steps reached: median [range]" in text
     assert "| 300 | 7,000 [6,000, 9,000] | 301 [300, 302] | 0.90 |" in text
     written = write_report(rows, FAKE, meta, tmp_path)
-    assert (tmp_path / "SGCRod-v0.png") in written
+    assert (tmp_path / "SGCRod-v1.png") in written
     data = json.loads((tmp_path / "leaderboard.json").read_text())
-    curve = data["learning_curves"]["SGCRod-v0/sac"]
+    curve = data["learning_curves"]["SGCRod-v1/sac"]
     assert curve["timesteps"] == [2500, 5000, 7000]
     assert curve["wall_clock"]["train_time_s"] == [76.0, 151.0, 301.0]
 
@@ -183,11 +183,11 @@ def test_a_budget_run_is_the_fixed_step_run_cut_where_the_budget_ended(
 
     from baselines.agents.train import TrainConfig, train
 
-    (tiny_hp / "sac.yml").write_text(yaml.safe_dump({"SGCPoint-v0": {
+    (tiny_hp / "sac.yml").write_text(yaml.safe_dump({"SGCPoint-v1": {
         "n_timesteps": 64, "policy": "MlpPolicy", "n_envs": 2, "learning_starts": 20,
         "batch_size": 16, "train_freq": 3, "policy_kwargs": "dict(net_arch=[8])",
     }}))  # fmt: skip
-    common = {"algo": algo, "env_id": "SGCPoint-v0", "seed": 4, "hyperparams_dir": tiny_hp}
+    common = {"algo": algo, "env_id": "SGCPoint-v1", "seed": 4, "hyperparams_dir": tiny_hp}
     cut = train(TrainConfig(**common, timesteps=10_000_000, time_budget_s=0.5))
     learned = cut.config["steps_learned"]
     chunk = 64 if algo == "ppo" else 6  # a rollout of 2 x 32; train_freq 3 x 2 envs
@@ -202,9 +202,9 @@ def test_the_budget_ends_dagger_rounds(tmp_path: Path) -> None:
     from baselines.agents.demos import record_demos
     from baselines.agents.train import TrainConfig, train
 
-    demos = record_demos("SGCPoint-v0", 1, seed=5).save(tmp_path / "demos.npz")
+    demos = record_demos("SGCPoint-v1", 1, seed=5).save(tmp_path / "demos.npz")
     result = train(TrainConfig(
-        algo="ppo", env_id="SGCPoint-v0", timesteps=0, init="bc", demos=demos, bc_epochs=1,
+        algo="ppo", env_id="SGCPoint-v1", timesteps=0, init="bc", demos=demos, bc_epochs=1,
         dagger_rounds=50, dagger_episodes=1, time_budget_s=1.0,
     ))  # fmt: skip
     assert result.config["budget_spent"] is True and result.timesteps == 0
@@ -219,7 +219,7 @@ def test_a_benchmark_run_under_a_budget_puts_its_curve_by_seconds(tiny_hp: Path)
 
     (recipe,) = recipes_from_algos(["ppo"], str(tiny_hp), timesteps=10_000_000,
                                    time_budget_s=1.0)  # fmt: skip
-    (spec,) = build_grid([recipe], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+    (spec,) = build_grid([recipe], ["SGCPoint-v1"], [0], eval_freq=0, curve_episodes=1,
                          eval_episodes=1)  # fmt: skip
     outcome = execute_run(spec.to_dict())
     assert outcome["status"] == "finished", outcome.get("traceback")
@@ -233,7 +233,7 @@ def test_a_benchmark_run_under_a_budget_puts_its_curve_by_seconds(tiny_hp: Path)
 def test_sgc_benchmark_names_a_bad_budget_or_recipe(
     tmp_path: Path, tiny_hp: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    base = ["benchmark", "--algo", "ppo", "--hyperparams", str(tiny_hp), "--env", "SGCPoint-v0",
+    base = ["benchmark", "--algo", "ppo", "--hyperparams", str(tiny_hp), "--env", "SGCPoint-v1",
             "--out", str(tmp_path / "out"), "--report-only", "--no-plots"]  # fmt: skip
     assert cli.main([*base, "--time-budget", "0"]) == 2
     assert "time_budget_s" in capsys.readouterr().err

@@ -28,7 +28,7 @@ def test_record_load_replay_matches(datasets: Path) -> None:
         warnings.simplefilter("error")  # no out-of-space actions, no Minari advice left
         # Gymnasium notes that an id has a newer version (the learner's view): not a defect
         warnings.filterwarnings("ignore", ".*is out of date", DeprecationWarning)
-        record_minari("SGCRod-v0", 2, 7, "sgc/rod/expert-v0", **publisher)
+        record_minari("SGCRod-v1", 2, 7, "sgc/rod/expert-v0", **publisher)
     dataset = minari.load_dataset("sgc/rod/expert-v0")
     assert dataset.total_episodes == 2
     assert dataset.action_space.dtype == np.float64
@@ -48,7 +48,7 @@ def test_record_load_replay_matches(datasets: Path) -> None:
 
 
 def test_fixed_info_has_one_shape_on_every_tick() -> None:
-    env = gym.make("SGCIntercept-v0")
+    env = gym.make("SGCIntercept-v1")
     _, info = env.reset(seed=0)
     quiet = fixed_info(info, 1)
     event = {"body": 0, "goal": 1, "time": 2.0, "position_error": 1e-16,
@@ -63,7 +63,7 @@ def test_fixed_info_has_one_shape_on_every_tick() -> None:
 
 @pytest.mark.filterwarnings("ignore:`(author|author_email|code_permalink)` is set to None")
 def test_cli_writes_a_dataset(datasets: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ["demos", "--env", "SGCIntercept-v0", "--episodes", "1", "--format", "minari",
+    argv = ["demos", "--env", "SGCIntercept-v1", "--episodes", "1", "--format", "minari",
             "--out", "sgc/intercept/expert-v0"]  # fmt: skip
     assert main(argv) == 0
     assert "1 episodes" in capsys.readouterr().out
@@ -83,15 +83,15 @@ def test_an_interrupted_write_leaves_no_dataset(
 
     monkeypatch.setattr(minari, "create_dataset_from_buffers", write_then_fail)
     with pytest.raises(KeyboardInterrupt):
-        record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+        record_minari("SGCPoint-v1", 1, 0, "sgc/point/cut-v0")
     assert not (datasets / "sgc").exists()
     assert [p.name for p in datasets.iterdir()] == []  # the staging folder went too
     monkeypatch.setattr(minari, "create_dataset_from_buffers", real)
-    record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+    record_minari("SGCPoint-v1", 1, 0, "sgc/point/cut-v0")
     assert minari.load_dataset("sgc/point/cut-v0").total_episodes == 1
     monkeypatch.setattr(gym, "make", None)  # a taken id is refused before any env is made
     with pytest.raises(ValueError, match="already exists"):
-        record_minari("SGCPoint-v0", 1, 0, "sgc/point/cut-v0")
+        record_minari("SGCPoint-v1", 1, 0, "sgc/point/cut-v0")
 
 
 @pytest.mark.parametrize("dataset_id", ["sgc-point", "sgc/point", "../escape-v0", "a b-v0"])
@@ -99,8 +99,8 @@ def test_a_malformed_dataset_id_is_refused_before_any_work(
     datasets: Path, capsys: pytest.CaptureFixture[str], dataset_id: str
 ) -> None:
     with pytest.raises(ValueError, match="dataset_id: expected"):
-        record_minari("SGCPoint-v0", 1, 0, dataset_id)
-    argv = ["demos", "--env", "SGCPoint-v0", "--episodes", "1", "--format", "minari",
+        record_minari("SGCPoint-v1", 1, 0, dataset_id)
+    argv = ["demos", "--env", "SGCPoint-v1", "--episodes", "1", "--format", "minari",
             "--out", dataset_id]  # fmt: skip
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()

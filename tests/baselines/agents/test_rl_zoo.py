@@ -19,7 +19,7 @@ def test_rl_zoo3_trains_ppo_on_sgc_point(tmp_path: Path) -> None:
     """A few hundred steps with ``python -m rl_zoo3.train`` (smaller rollouts than the file's,
     overridden on the command line as a zoo user would); the saved model acts on the env."""
     command = [
-        sys.executable, "-m", "rl_zoo3.train", "--algo", "ppo", "--env", "SGCPoint-v0",
+        sys.executable, "-m", "rl_zoo3.train", "--algo", "ppo", "--env", "SGCPoint-v1",
         "--gym-packages", "sgc_env", "--conf-file", str(hyperparams_file("ppo")),
         "-n", "256", "--hyperparams", "n_envs:1", "n_steps:128", "batch_size:64",
         "--eval-freq", "-1", "--save-freq", "-1", "--vec-env", "dummy", "--seed", "0",
@@ -28,10 +28,10 @@ def test_rl_zoo3_trains_ppo_on_sgc_point(tmp_path: Path) -> None:
     done = subprocess.run(command, capture_output=True, text=True, timeout=600, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     assert "total_timesteps      | 256" in done.stdout
-    (model_file,) = (tmp_path / "logs" / "ppo").glob("SGCPoint-v0_*/SGCPoint-v0.zip")
+    (model_file,) = (tmp_path / "logs" / "ppo").glob("SGCPoint-v1_*/SGCPoint-v1.zip")
     from stable_baselines3 import PPO
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     model = PPO.load(model_file, device="cpu")
     obs, _ = env.reset(seed=0)
     action, _ = model.predict(obs, deterministic=True)
@@ -54,7 +54,7 @@ def test_zoo_files_name_stock_classes_and_the_newest_ids(algo: str) -> None:
     import yaml
 
     table = yaml.safe_load(text)
-    assert table and set(table) <= set(sgc_env.LEARNER_IDS)
+    assert table and set(table) <= set(sgc_env.ENV_IDS)
     for env_id, hp in table.items():
         assert hp["policy"] in ("MlpPolicy", "MultiInputPolicy"), env_id
         assert get_wrapper_class(hp) is None and "env_wrapper" not in hp

@@ -29,7 +29,7 @@ def _equal(a: object, b: object) -> bool:
     return bool(np.array_equal(a, b))
 
 
-@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCPointGoal-v0"])
+@pytest.mark.parametrize("env_id", ["SGCRod-v1", "SGCPointGoal-v1"])
 def test_adapter_steps_as_dummy_vec_env(env_id: str) -> None:
     kwargs = {"max_episode_steps": 30}  # truncations come with terminal observations
     batched = make_sgc_vec(env_id, 3, seed=7, vec="batched", env_kwargs=kwargs)
@@ -66,7 +66,7 @@ def test_ppo_vecnormalize_evaluate_and_expert_on_the_batched_env() -> None:
     short = {"max_episode_steps": 20}
     params = []
     for kind in ("batched", "dummy"):
-        env = VecNormalize(make_sgc_vec("SGCPoint-v0", 4, seed=0, env_kwargs=short, vec=kind))
+        env = VecNormalize(make_sgc_vec("SGCPoint-v1", 4, seed=0, env_kwargs=short, vec=kind))
         model = PPO("MlpPolicy", env, n_steps=16, batch_size=32, n_epochs=1, seed=0)
         model.learn(64)
         assert model.num_timesteps == 64
@@ -79,7 +79,7 @@ def test_ppo_vecnormalize_evaluate_and_expert_on_the_batched_env() -> None:
     assert np.array_equal(*params)
     returns = []
     for kind in ("batched", "dummy"):
-        vec = make_sgc_vec("SGCRod-v0", 2, seed=3, vec=kind)
+        vec = make_sgc_vec("SGCRod-v1", 2, seed=3, vec=kind)
         expert = SGCExpert(vec)  # reads the masses and limits of sub-env 0
         assert base_env(vec, 1).scenario is vec.get_attr("scenario", [1])[0]
         obs = vec.reset()
@@ -94,10 +94,10 @@ def test_ppo_vecnormalize_evaluate_and_expert_on_the_batched_env() -> None:
 
 def test_adapter_refuses_bad_input() -> None:
     with pytest.raises(ValueError, match="vec: expected one of"):
-        make_sgc_vec("SGCRod-v0", 2, vec="threads")
+        make_sgc_vec("SGCRod-v1", 2, vec="threads")
     with pytest.raises(ValueError, match="no batched env"):
         make_sgc_vec("CartPole-v1", 2, vec="batched")
-    env = BatchedVecEnv("SGCRod-v0", 2)
+    env = BatchedVecEnv("SGCRod-v1", 2)
     env.reset()
     actions = np.zeros((2, 6), np.float32)
     actions[1, 3] = np.nan
@@ -119,7 +119,7 @@ def test_comparison_policies_run_on_the_batched_env(policy: str) -> None:
     cls = DynamicConstraintsController if policy == "dc" else MinimumJerkController
     runs = []
     for kind in ("batched", "dummy"):
-        vec = make_sgc_vec("SGCRod-v0", 2, seed=5, vec=kind)
+        vec = make_sgc_vec("SGCRod-v1", 2, seed=5, vec=kind)
         controller = cls(vec)
         obs = vec.reset()
         trace = []

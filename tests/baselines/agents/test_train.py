@@ -16,7 +16,7 @@ from baselines.agents.train import TrainConfig, train  # noqa: E402
 
 TINY = {
     "ppo.yml": """
-SGCPoint-v0:
+SGCPoint-v1:
   n_timesteps: 256
   policy: MlpPolicy
   n_envs: 2
@@ -26,7 +26,7 @@ SGCPoint-v0:
   policy_kwargs: "dict(net_arch=[16], activation_fn=nn.Tanh)"
 """,
     "sac.yml": """
-SGCPoint-v0:
+SGCPoint-v1:
   n_timesteps: 200
   policy: MlpPolicy
   learning_starts: 100
@@ -35,7 +35,7 @@ SGCPoint-v0:
   policy_kwargs: "dict(net_arch=[16])"
 """,
     "td3.yml": """
-SGCPoint-v0:
+SGCPoint-v1:
   n_timesteps: 200
   policy: MlpPolicy
   learning_starts: 100
@@ -47,7 +47,7 @@ SGCPoint-v0:
   policy_kwargs: "dict(net_arch=[16])"
 """,
     "her.yml": """
-SGCPointGoal-v0:
+SGCPointGoal-v1:
   n_timesteps: 200
   policy: MultiInputPolicy
   learning_starts: 160
@@ -84,8 +84,8 @@ def test_parse_kwargs_string_is_safe() -> None:
 
 
 def test_shipped_hyperparams_load_for_every_algo() -> None:
-    for algo, env_id in (("ppo", "SGCPoint-v0"), ("sac", "SGCRod-v0"), ("td3", "SGCPoint-v0"),
-                         ("her", "SGCPointGoal-v0")):  # fmt: skip
+    for algo, env_id in (("ppo", "SGCPoint-v1"), ("sac", "SGCRod-v1"), ("td3", "SGCPoint-v1"),
+                         ("her", "SGCPointGoal-v1")):  # fmt: skip
         hp = load_hyperparams(algo, env_id)
         assert hp.n_timesteps > 0 and hp.policy
         assert "net_arch" in hp.algo_kwargs["policy_kwargs"]
@@ -93,30 +93,30 @@ def test_shipped_hyperparams_load_for_every_algo() -> None:
 
 def test_hyperparams_errors_name_the_field(tmp_path: Path, tiny_hp: Path) -> None:
     with pytest.raises(ValueError, match="algo"):
-        load_hyperparams("dqn", "SGCPoint-v0", tiny_hp)
-    with pytest.raises(ValueError, match="SGCRod-v0"):
-        load_hyperparams("ppo", "SGCRod-v0", tiny_hp)
+        load_hyperparams("dqn", "SGCPoint-v1", tiny_hp)
+    with pytest.raises(ValueError, match="SGCRod-v1"):
+        load_hyperparams("ppo", "SGCRod-v1", tiny_hp)
     (tmp_path / "bad").mkdir()
-    (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v0: {policy: MlpPolicy\n")
+    (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v1: {policy: MlpPolicy\n")
     with pytest.raises(ValueError, match="not valid YAML"):
-        load_hyperparams("ppo", "SGCPoint-v0", tmp_path / "bad")
-    (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v0: {policy: MlpPolicy}\n")
+        load_hyperparams("ppo", "SGCPoint-v1", tmp_path / "bad")
+    (tmp_path / "bad" / "ppo.yml").write_text("SGCPoint-v1: {policy: MlpPolicy}\n")
     with pytest.raises(ValueError, match="n_timesteps"):
-        load_hyperparams("ppo", "SGCPoint-v0", tmp_path / "bad")
+        load_hyperparams("ppo", "SGCPoint-v1", tmp_path / "bad")
     (tmp_path / "bad" / "ppo.yml").write_text(
-        "SGCPoint-v0: {policy: MlpPolicy, n_timesteps: 10, n_stepz: 5}\n"
+        "SGCPoint-v1: {policy: MlpPolicy, n_timesteps: 10, n_stepz: 5}\n"
     )
     with pytest.raises(ValueError, match="n_stepz"):
-        load_hyperparams("ppo", "SGCPoint-v0", tmp_path / "bad")
+        load_hyperparams("ppo", "SGCPoint-v1", tmp_path / "bad")
 
 
 def test_train_rejects_bad_arguments(tiny_hp: Path) -> None:
     with pytest.raises(ValueError, match="algo"):
-        train(TrainConfig(algo="a3c", env_id="SGCPoint-v0", hyperparams_dir=tiny_hp))
+        train(TrainConfig(algo="a3c", env_id="SGCPoint-v1", hyperparams_dir=tiny_hp))
     with pytest.raises(ValueError, match="env"):
         train(TrainConfig(algo="ppo", env_id="Nope-v0", hyperparams_dir=tiny_hp))
     with pytest.raises(ValueError, match="demos"):
-        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", init="bc", hyperparams_dir=tiny_hp))
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", init="bc", hyperparams_dir=tiny_hp))
 
 
 # ---------------------------------------------------------------- smoke runs
@@ -124,8 +124,8 @@ def test_train_rejects_bad_arguments(tiny_hp: Path) -> None:
 
 @pytest.mark.parametrize(
     ("algo", "env_id"),
-    [("ppo", "SGCPoint-v0"), ("sac", "SGCPoint-v0"), ("td3", "SGCPoint-v0"),
-     ("her", "SGCPointGoal-v0")],
+    [("ppo", "SGCPoint-v1"), ("sac", "SGCPoint-v1"), ("td3", "SGCPoint-v1"),
+     ("her", "SGCPointGoal-v1")],
 )  # fmt: skip
 def test_smoke_train_save_load_evaluate(
     algo: str, env_id: str, tiny_hp: Path, tmp_path: Path
@@ -169,7 +169,7 @@ def test_same_seed_same_parameters_and_scorecard(tiny_hp: Path) -> None:
         train(
             TrainConfig(
                 algo="ppo",
-                env_id="SGCPoint-v0",
+                env_id="SGCPoint-v1",
                 seed=7,
                 eval_freq=256,
                 eval_episodes=1,
@@ -182,7 +182,7 @@ def test_same_seed_same_parameters_and_scorecard(tiny_hp: Path) -> None:
     keys = ("success_rate", "position_error_mean", "position_error_max", "return_mean")
     first, second = runs[0].evaluations[-1], runs[1].evaluations[-1]
     assert {k: first[k] for k in keys} == {k: second[k] for k in keys}
-    other = train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", seed=8, timesteps=128,
+    other = train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", seed=8, timesteps=128,
                               hyperparams_dir=tiny_hp))  # fmt: skip
     assert not np.array_equal(_ppo_params(runs[0].model), _ppo_params(other.model))
 
@@ -194,11 +194,11 @@ def test_demos_roundtrip_and_cli(tmp_path: Path) -> None:
     from baselines.agents.demos import load_demos, record_demos
     from baselines.cli.commands import demos as demos_command
 
-    demos = record_demos("SGCPoint-v0", 2, seed=5)
+    demos = record_demos("SGCPoint-v1", 2, seed=5)
     assert demos.n_episodes == 2 and list(demos.seeds) == [5, 6]
     import gymnasium as gym
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     obs_shape = env.observation_space.shape
     env.close()
     assert demos.observations.shape == (len(demos), *obs_shape)
@@ -209,15 +209,15 @@ def test_demos_roundtrip_and_cli(tmp_path: Path) -> None:
     parser = argparse.ArgumentParser()
     demos_command.add_arguments(parser)
     args = parser.parse_args(
-        ["--env", "SGCPoint-v0", "--episodes", "2", "--seed", "5", "--out", str(path)]
+        ["--env", "SGCPoint-v1", "--episodes", "2", "--seed", "5", "--out", str(path)]
     )
     assert demos_command.run(args) == 0
     loaded = load_demos(path)
     np.testing.assert_array_equal(loaded.actions, demos.actions)
     np.testing.assert_array_equal(loaded.observations, demos.observations)
-    assert loaded.env_id == "SGCPoint-v0" and loaded.env_kwargs == {}
+    assert loaded.env_id == "SGCPoint-v1" and loaded.env_kwargs == {}
     with pytest.raises(ValueError, match="env"):
-        record_demos("SGCPointGoal-v0", 1, seed=0)
+        record_demos("SGCPointGoal-v1", 1, seed=0)
     with pytest.raises(ValueError, match="demos"):
         load_demos(tmp_path / "missing.npz")
 
@@ -230,9 +230,9 @@ def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
     from baselines.agents.pushes import Pushes
     from baselines.cli.commands import demos as demos_command
 
-    plain = record_demos("SGCThreeRods-v1", 2, seed=0)
-    pushed = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(**PUSHES))
-    again = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(**PUSHES))
+    plain = record_demos("SGCThreeRods-v2", 2, seed=0)
+    pushed = record_demos("SGCThreeRods-v2", 2, seed=0, pushes=Pushes(**PUSHES))
+    again = record_demos("SGCThreeRods-v2", 2, seed=0, pushes=Pushes(**PUSHES))
     np.testing.assert_array_equal(pushed.observations, again.observations)
     np.testing.assert_array_equal(pushed.actions, again.actions)
     first, second = (obs for obs in np.split(plain.observations, 2))
@@ -240,13 +240,13 @@ def test_pushes_are_seeded_and_recorded(tmp_path: Path) -> None:
     starts = np.flatnonzero(pushed.episode_starts)
     assert not np.array_equal(pushed.observations[starts[0]], plain.observations[0])
     assert not np.array_equal(pushed.observations[starts[0]], pushed.observations[starts[1]])
-    never = record_demos("SGCThreeRods-v1", 2, seed=0, pushes=Pushes(scale=0.5, prob=0.0))
+    never = record_demos("SGCThreeRods-v2", 2, seed=0, pushes=Pushes(scale=0.5, prob=0.0))
     np.testing.assert_array_equal(never.observations, plain.observations)
     path = tmp_path / "pushed.npz"
     parser = argparse.ArgumentParser()
     demos_command.add_arguments(parser)
     args = parser.parse_args(
-        ["--env", "SGCThreeRods-v1", "--episodes", "2", "--seed", "0", "--out", str(path),
+        ["--env", "SGCThreeRods-v2", "--episodes", "2", "--seed", "0", "--out", str(path),
          "--push-scale", "0.5", "--push-spin", "0.5", "--push-prob", "0.1", "--push-start"]
     )  # fmt: skip
     assert demos_command.run(args) == 0
@@ -276,12 +276,12 @@ def test_bad_push_arguments_raise(kwargs: dict, name: str, tiny_hp: Path) -> Non
     with pytest.raises(ValueError, match=name):
         Pushes(**kwargs)
     with pytest.raises(ValueError, match=name):
-        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", hyperparams_dir=tiny_hp,
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", hyperparams_dir=tiny_hp,
                           **{f"push_{k}": v for k, v in kwargs.items()}))  # fmt: skip
     with pytest.raises(ValueError, match="seed"):
         push_rng(-1)
     with pytest.raises(ValueError, match="dagger-rounds"):
-        train(TrainConfig(algo="ppo", env_id="SGCPoint-v0", hyperparams_dir=tiny_hp,
+        train(TrainConfig(algo="ppo", env_id="SGCPoint-v1", hyperparams_dir=tiny_hp,
                           push_scale=0.1))  # fmt: skip
 
 
@@ -291,10 +291,10 @@ def test_dagger_pushes_diversify_rollouts_of_a_fixed_scene() -> None:
     from baselines.agents.pushes import Pushes
     from baselines.agents.train import algorithm_class
 
-    demos = record_demos("SGCIntercept-v0", 1, seed=0)
+    demos = record_demos("SGCIntercept-v1", 1, seed=0)
 
     def rollout_states(pushes: Pushes | None) -> np.ndarray:
-        model = algorithm_class("ppo")("MlpPolicy", "SGCIntercept-v0", seed=0, device="cpu",
+        model = algorithm_class("ppo")("MlpPolicy", "SGCIntercept-v1", seed=0, device="cpu",
                                        policy_kwargs={"net_arch": [8]})  # fmt: skip
         aggregate, _ = dagger(model, demos, 1, 2, seed=0, epochs=1, pushes=pushes)
         return aggregate.observations[len(demos) :]
@@ -313,12 +313,12 @@ def test_behaviour_cloning_reduces_imitation_loss(tmp_path: Path, tiny_hp: Path)
     from baselines.agents.bc import imitation_loss
     from baselines.agents.demos import record_demos
 
-    demos = record_demos("SGCPoint-v0", 3, seed=0)
+    demos = record_demos("SGCPoint-v1", 3, seed=0)
     path = demos.save(tmp_path / "d.npz")
     result = train(
         TrainConfig(
             algo="ppo",
-            env_id="SGCPoint-v0",
+            env_id="SGCPoint-v1",
             timesteps=0,
             init="bc",
             demos=path,
@@ -336,7 +336,7 @@ def test_behaviour_cloning_reduces_imitation_loss(tmp_path: Path, tiny_hp: Path)
 
     from baselines.policies import load_sb3_model
 
-    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip", env=gym.make("SGCPoint-v0"))
+    reloaded = load_sb3_model(tmp_path / "bc" / "final_model.zip", env=gym.make("SGCPoint-v1"))
     obs = demos.observations[:5]
     np.testing.assert_allclose(
         reloaded.predict(obs, deterministic=True)[0],
@@ -351,8 +351,8 @@ def test_behaviour_cloning_into_off_policy_actor(algo: str, tiny_hp: Path) -> No
     from baselines.agents.demos import record_demos
     from baselines.agents.train import algorithm_class
 
-    demos = record_demos("SGCPoint-v0", 2, seed=1)
-    model = algorithm_class(algo)("MlpPolicy", "SGCPoint-v0", seed=0, device="cpu",
+    demos = record_demos("SGCPoint-v1", 2, seed=1)
+    model = algorithm_class(algo)("MlpPolicy", "SGCPoint-v1", seed=0, device="cpu",
                                   policy_kwargs={"net_arch": [32]})  # fmt: skip
     before = imitation_loss(model, demos)
     behaviour_clone(model, demos, epochs=20, seed=0)
@@ -368,7 +368,7 @@ def test_train_command_runs(tmp_path: Path, tiny_hp: Path) -> None:
     parser = argparse.ArgumentParser()
     train_command.add_arguments(parser)
     args = parser.parse_args(
-        ["--algo", "ppo", "--env", "SGCPoint-v0", "--timesteps", "128", "--out",
+        ["--algo", "ppo", "--env", "SGCPoint-v1", "--timesteps", "128", "--out",
          str(tmp_path / "run"), "--hyperparams", str(tiny_hp)]
     )  # fmt: skip
     assert train_command.run(args) == 0
@@ -390,39 +390,39 @@ def test_shipped_checkpoints_are_small_and_score() -> None:
     if not models:
         pytest.skip("no shipped checkpoints")
     assert sum(m.stat().st_size for m in models) <= 5 * 1024 * 1024
-    point = CHECKPOINTS / "ppo_dagger_SGCPoint-v0.zip"
+    point = CHECKPOINTS / "ppo_dagger_SGCPoint-v1.zip"
     assert point.is_file()
-    result = evaluate(str(point), "SGCPoint-v0", 10, 10_000)
+    result = evaluate(str(point), "SGCPoint-v1", 10, 10_000)
     assert result.summary["success_rate"] >= 0.9
     assert result.summary["position_error_max"] <= 0.02
 
 
 #: Shipped model -> (env id, success it must keep on held-out seed 10000), docs/agents.md.
 SHIPPED_SCORES = {
-    "ppo_dagger_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
-    "ppo_dagger_SGCRod-v0.zip": ("SGCRod-v0", 0.8),
-    "ppo_dagger_SGCIntercept-v0.zip": ("SGCIntercept-v0", 1.0),
-    "ppo_schedule_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
-    "ppo_schedule_SGCRod-v0.zip": ("SGCRod-v0", 0.9),
-    "ppo_perbody_SGCThreeRodsRandom-v2.zip": ("SGCThreeRodsRandom-v2", 0.85),
+    "ppo_dagger_SGCPoint-v1.zip": ("SGCPoint-v1", 0.9),
+    "ppo_dagger_SGCRod-v1.zip": ("SGCRod-v1", 0.8),
+    "ppo_dagger_SGCIntercept-v1.zip": ("SGCIntercept-v1", 1.0),
+    "ppo_schedule_SGCPoint-v1.zip": ("SGCPoint-v1", 0.9),
+    "ppo_schedule_SGCRod-v1.zip": ("SGCRod-v1", 0.9),
+    "ppo_perbody_SGCThreeRodsRandom-v3.zip": ("SGCThreeRodsRandom-v3", 0.85),
     "ppo_caps_SGCThreeRodsRandom-v3.zip": ("SGCThreeRodsRandom-v3", 0.85),
-    "ppo_rod300_SGCRod-v0.zip": ("SGCRod-v0", 0.8),
-    "ppo_point500k_SGCPoint-v0.zip": ("SGCPoint-v0", 0.9),
+    "ppo_rod300_SGCRod-v1.zip": ("SGCRod-v1", 0.8),
+    "ppo_point500k_SGCPoint-v1.zip": ("SGCPoint-v1", 0.9),
 }
 
 
 def _schedule_model_summary(episodes: int) -> dict:
     from baselines.evaluation.harness import evaluate
 
-    model = CHECKPOINTS / "ppo_schedule_SGCPoint-v0.zip"
-    return dict(evaluate(str(model), "SGCPoint-v0", episodes, 20_000).summary)
+    model = CHECKPOINTS / "ppo_schedule_SGCPoint-v1.zip"
+    return dict(evaluate(str(model), "SGCPoint-v1", episodes, 20_000).summary)
 
 
 def test_model_learned_without_demonstrations_meets_half_the_point_goals() -> None:
     """Issue 15's bar on 10 held-out episodes (30 goals, 2 cm on the tick); the manifest says
     it learned from scratch. The 50 episodes of the bar are the slow test below."""
     entry = next(e for e in json.loads((CHECKPOINTS / "manifest.json").read_text())
-                 if e["file"] == "ppo_schedule_SGCPoint-v0.zip")  # fmt: skip
+                 if e["file"] == "ppo_schedule_SGCPoint-v1.zip")  # fmt: skip
     assert entry["demonstrations"] is False and entry["timesteps"] > 0
     summary = _schedule_model_summary(10)
     assert summary["success_rate"] >= 0.5, summary
@@ -438,8 +438,8 @@ def test_model_learned_without_demonstrations_on_fifty_held_out_episodes() -> No
 def _rod_model_summary(episodes: int) -> dict:
     from baselines.evaluation.harness import evaluate
 
-    model = CHECKPOINTS / "ppo_dagger_SGCRod-v0.zip"
-    return dict(evaluate(str(model), "SGCRod-v0", episodes, 10_000).summary)
+    model = CHECKPOINTS / "ppo_dagger_SGCRod-v1.zip"
+    return dict(evaluate(str(model), "SGCRod-v1", episodes, 10_000).summary)
 
 
 def test_shipped_rod_model_meets_eighty_percent_of_goals_with_orientation() -> None:
@@ -479,11 +479,11 @@ def test_dagger_reaches_ninety_percent_on_point(tmp_path: Path) -> None:
     """The shipped recipe, end to end (about two minutes on one CPU core)."""
     from baselines.agents.demos import record_demos
 
-    path = record_demos("SGCPoint-v0", 200, seed=0).save(tmp_path / "demos.npz")
+    path = record_demos("SGCPoint-v1", 200, seed=0).save(tmp_path / "demos.npz")
     result = train(
         TrainConfig(
             algo="ppo",
-            env_id="SGCPoint-v0",
+            env_id="SGCPoint-v1",
             seed=0,
             timesteps=0,
             init="bc",
@@ -508,7 +508,7 @@ def test_critic_warmup_keeps_the_actor_still() -> None:
 
     def fresh():
         return algorithm_class("ppo")(
-            "MlpPolicy", "SGCPoint-v0", seed=1, device="cpu", n_steps=64, batch_size=64,
+            "MlpPolicy", "SGCPoint-v1", seed=1, device="cpu", n_steps=64, batch_size=64,
             n_epochs=2, policy_kwargs={"net_arch": [16]},
         )  # fmt: skip
 
@@ -526,14 +526,14 @@ def test_normalize_saves_statistics_and_evaluates_on_raw_observations(tmp_path: 
     folder = tmp_path / "hp"
     folder.mkdir()
     (folder / "ppo.yml").write_text(
-        "SGCPoint-v0: {n_timesteps: 128, policy: MlpPolicy, n_steps: 64, batch_size: 64,\n"
+        "SGCPoint-v1: {n_timesteps: 128, policy: MlpPolicy, n_steps: 64, batch_size: 64,\n"
         "  n_epochs: 1, normalize: true, policy_kwargs: 'dict(net_arch=[8])'}\n"
     )
     out = tmp_path / "run"
     result = train(
         TrainConfig(
             algo="ppo",
-            env_id="SGCPoint-v0",
+            env_id="SGCPoint-v1",
             eval_freq=128,
             eval_episodes=1,
             hyperparams_dir=folder,

@@ -32,7 +32,7 @@ from baselines.benchmark.grid import (  # noqa: E402
 from baselines.cli import main as cli  # noqa: E402
 
 TINY_PPO = """
-SGCPoint-v0:
+SGCPoint-v1:
   n_timesteps: 128
   policy: MlpPolicy
   n_envs: 2
@@ -118,10 +118,10 @@ def test_learning_curve_uses_steps_every_run_has() -> None:
 
 def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
     recipes = recipes_from_algos(["ppo"], str(tiny_hp), {"reward": "distance"}, 64)
-    (spec,) = build_grid(recipes, ["SGCPoint-v0"], [3], eval_freq=64, curve_episodes=1,
+    (spec,) = build_grid(recipes, ["SGCPoint-v1"], [3], eval_freq=64, curve_episodes=1,
                          eval_episodes=2)  # fmt: skip
     command = train_command(spec.train_options(out="DIR"))
-    assert command == (f"sgc train --algo ppo --env SGCPoint-v0 --seed 3 --timesteps 64 "
+    assert command == (f"sgc train --algo ppo --env SGCPoint-v1 --seed 3 --timesteps 64 "
                        f"--out DIR --eval-freq 64 --eval-episodes 1 --hyperparams {tiny_hp} "
                        "--env-kwargs '{\"reward\": \"distance\"}'")  # fmt: skip
 
@@ -140,7 +140,7 @@ def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
     ],
 )
 def test_bad_grid_arguments_are_named(kwargs: dict, message: str) -> None:
-    args = {"recipes": [Recipe("ppo", "ppo")], "env_ids": ["SGCPoint-v0"], "seeds": [0],
+    args = {"recipes": [Recipe("ppo", "ppo")], "env_ids": ["SGCPoint-v1"], "seeds": [0],
             "eval_freq": 0, "curve_episodes": 1, "eval_episodes": 2, **kwargs}  # fmt: skip
     with pytest.raises(ValueError, match=message):
         build_grid(args.pop("recipes"), args.pop("env_ids"), args.pop("seeds"), **args)
@@ -156,9 +156,9 @@ def test_recipes_file(tmp_path: Path, tiny_hp: Path) -> None:
     tiny, clone = load_recipes(path)
     assert tiny.hyperparams == str(tiny_hp) and not tiny.demonstrations
     assert clone.demonstrations
-    (spec,) = build_grid([clone], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+    (spec,) = build_grid([clone], ["SGCPoint-v1"], [0], eval_freq=0, curve_episodes=1,
                          eval_episodes=1)  # fmt: skip
-    assert spec.train_options(None)["demos"] == "d/SGCPoint-v0.npz"
+    assert spec.train_options(None)["demos"] == "d/SGCPoint-v1.npz"
     path.write_text("recipes:\n  - {algo: ppo, train: {seed: 3}}\n")
     with pytest.raises(ValueError, match=r"recipe 0: train option\(s\) \['seed'\]"):
         load_recipes(path)
@@ -170,33 +170,33 @@ def test_recipes_file(tmp_path: Path, tiny_hp: Path) -> None:
 def test_a_recipe_runs_only_on_its_envs(tmp_path: Path) -> None:
     (tmp_path / "hp").mkdir()
     (tmp_path / "hp" / "ppo.yml").write_text(
-        "SGCPoint-v0: &p {n_timesteps: 64, policy: MlpPolicy}\nSGCPointGoal-v0: *p\n"
+        "SGCPoint-v1: &p {n_timesteps: 64, policy: MlpPolicy}\nSGCPointGoal-v1: *p\n"
     )
     path = tmp_path / "recipes.yml"
     path.write_text(
         "recipes:\n  - {name: everywhere, algo: ppo, hyperparams: hp}\n"
-        "  - {name: goal-only, algo: her, envs: [SGCPointGoal-v0]}\n"
+        "  - {name: goal-only, algo: her, envs: [SGCPointGoal-v1]}\n"
     )
     everywhere, goal_only = load_recipes(path)
-    assert goal_only.envs == ("SGCPointGoal-v0",) and everywhere.envs == ()
-    grid = build_grid([everywhere, goal_only], ["SGCPoint-v0", "SGCPointGoal-v0"], [0, 1],
+    assert goal_only.envs == ("SGCPointGoal-v1",) and everywhere.envs == ()
+    grid = build_grid([everywhere, goal_only], ["SGCPoint-v1", "SGCPointGoal-v1"], [0, 1],
                       eval_freq=0, curve_episodes=1, eval_episodes=1)  # fmt: skip
     cells = [(spec.env_id, spec.recipe.name) for spec in grid]
-    assert ("SGCPoint-v0", "goal-only") not in cells
-    assert cells.count(("SGCPointGoal-v0", "goal-only")) == 2 and len(cells) == 6
+    assert ("SGCPoint-v1", "goal-only") not in cells
+    assert cells.count(("SGCPointGoal-v1", "goal-only")) == 2 and len(cells) == 6
     with pytest.raises(ValueError, match="none of its envs"):
-        build_grid([goal_only], ["SGCPoint-v0"], [0], eval_freq=0, curve_episodes=1,
+        build_grid([goal_only], ["SGCPoint-v1"], [0], eval_freq=0, curve_episodes=1,
                    eval_episodes=1)  # fmt: skip
     path.write_text("recipes:\n  - {algo: ppo, envs: [Nope-v0]}\n")
     with pytest.raises(ValueError, match="recipe 0: envs"):
         load_recipes(path)
-    path.write_text("recipes:\n  - {algo: ppo, envs: SGCPoint-v0}\n")
+    path.write_text("recipes:\n  - {algo: ppo, envs: SGCPoint-v1}\n")
     with pytest.raises(ValueError, match="envs must be a list"):
         load_recipes(path)
 
 
 def test_cli_reports_bad_arguments(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    argv = ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "0",
+    argv = ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v1", "--seeds", "0",
             "--out", str(tmp_path)]  # fmt: skip
     assert cli.main(argv) == 2
     assert "--seeds must be >= 1" in capsys.readouterr().err
@@ -228,7 +228,7 @@ def test_a_lost_worker_is_a_failed_run_and_the_grid_goes_on() -> None:
 
 
 def _tiny_argv(out: Path, hp: Path, *extra: str) -> list[str]:
-    return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v0", "--seeds", "2",
+    return ["benchmark", "--algo", "ppo", "--env", "SGCPoint-v1", "--seeds", "2",
             "--timesteps", "128", "--eval-episodes", "2", "--curve-episodes", "1",
             "--eval-freq", "128", "--hyperparams", str(hp), "--workers", "2", "--no-plots",
             "--out", str(out), *extra]  # fmt: skip
@@ -252,7 +252,7 @@ def test_local_and_ray_give_the_same_leaderboard_and_resume(tmp_path: Path, tiny
     (row,) = rows
     assert row["seeds"] == [0, 1] and row["timesteps"] == [128, 128]
     assert row["final"]["success_rate"]["n"] == 2
-    run = local / "runs" / "SGCPoint-v0" / "ppo" / "seed1"
+    run = local / "runs" / "SGCPoint-v1" / "ppo" / "seed1"
     for name in ("config.json", "command.txt", "final_model.zip", "best_model.zip"):
         assert (run / name).is_file(), name
     command = (run / "command.txt").read_text()
@@ -269,11 +269,11 @@ def test_failed_runs_are_recorded_and_retried_on_request(
     recipes = tmp_path / "r.yml"
     recipes.write_text(f"recipes:\n  - {{name: clone, algo: ppo, hyperparams: {tiny_hp}, "
                        "timesteps: 0, train: {init: bc, demos: missing.npz}}\n")  # fmt: skip
-    argv = ["benchmark", "--recipes", str(recipes), "--env", "SGCPoint-v0", "--seeds", "1",
+    argv = ["benchmark", "--recipes", str(recipes), "--env", "SGCPoint-v1", "--seeds", "1",
             "--eval-episodes", "1", "--curve-episodes", "1", "--workers", "1", "--no-plots",
             "--out", str(tmp_path / "b")]  # fmt: skip
     assert cli.main(argv) == 1
-    failed = tmp_path / "b" / "runs" / "SGCPoint-v0" / "clone" / "seed0" / "failed.json"
+    failed = tmp_path / "b" / "runs" / "SGCPoint-v1" / "clone" / "seed0" / "failed.json"
     record = json.loads(failed.read_text())
     assert record["status"] == "failed" and "missing.npz" in record["traceback"]
     assert "1 failed before (skipped" not in capsys.readouterr().out
@@ -305,7 +305,7 @@ def _start(out: Path, hp: Path) -> subprocess.Popen:
 
 
 def _run(out: Path, seed: int) -> Path:
-    return out / "runs" / "SGCPoint-v0" / "ppo" / f"seed{seed}"
+    return out / "runs" / "SGCPoint-v1" / "ppo" / f"seed{seed}"
 
 
 def test_sigkill_mid_grid_resumes_without_retraining_the_finished_run(
@@ -341,7 +341,7 @@ def test_two_benchmarks_on_one_out_train_each_run_once_and_leave_it_whole(
     assert [p.returncode for p in procs] == [0, 0], logs
     trained = [line for log in logs for line in log.splitlines() if ": finished in" in line]
     assert sorted(line.split(":")[0] for line in trained) == [
-        "SGCPoint-v0/ppo/seed0", "SGCPoint-v0/ppo/seed1",
+        "SGCPoint-v1/ppo/seed0", "SGCPoint-v1/ppo/seed1",
     ], logs  # fmt: skip
     for seed in (0, 1):
         record = json.loads((_run(out, seed) / "result.json").read_text())

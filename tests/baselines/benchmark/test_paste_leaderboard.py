@@ -25,14 +25,14 @@ outro
 
 def test_each_marker_pair_takes_its_own_leaderboard() -> None:
     paste = _paste_module()
-    body = paste.leaderboard_body("# Leaderboard\n\n## SGCRod-v0\n\n| a |\n")
-    assert body == "### SGCRod-v0\n\n| a |"
+    body = paste.leaderboard_body("# Leaderboard\n\n## SGCRod-v1\n\n| a |\n")
+    assert body == "### SGCRod-v1\n\n| a |"
     out = paste.paste(DOC, body, "doc", "budget-leaderboard")
     assert "old budget table" not in out and "old steps table" in out
-    assert out.count("### SGCRod-v0") == 1
-    assert out.index("### SGCRod-v0") > out.index("middle")
+    assert out.count("### SGCRod-v1") == 1
+    assert out.index("### SGCRod-v1") > out.index("middle")
     out = paste.paste(out, "steps", "doc")  # the default pair
-    assert "old steps table" not in out and "### SGCRod-v0" in out
+    assert "old steps table" not in out and "### SGCRod-v1" in out
 
 
 def test_a_missing_or_doubled_marker_is_an_error_naming_the_document() -> None:

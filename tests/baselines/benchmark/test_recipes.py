@@ -43,7 +43,7 @@ def test_the_timed_recipes_resolve_with_a_fixed_step_budget() -> None:
     from baselines.agents.hyperparams import load_hyperparams
     from baselines.benchmark.grid import load_recipes
 
-    timed = (("fast_recipes.yml", "SGCRod-v0"), ("fast_recipes_point.yml", "SGCPoint-v0"))
+    timed = (("fast_recipes.yml", "SGCRod-v1"), ("fast_recipes_point.yml", "SGCPoint-v1"))
     for name, env_id in timed:
         recipes = load_recipes(ROOT / "benchmarks" / "archive" / name)
         assert [r.envs for r in recipes] == [(env_id,)]
@@ -58,13 +58,13 @@ def test_seed_table_scores_a_finished_run(tmp_path: Path) -> None:
     hp = tmp_path / "hp"
     hp.mkdir()
     (hp / "ppo.yml").write_text(
-        "SGCPoint-v0:\n  n_timesteps: 128\n  policy: MlpPolicy\n  n_envs: 2\n  n_steps: 64\n"
+        "SGCPoint-v1:\n  n_timesteps: 128\n  policy: MlpPolicy\n  n_envs: 2\n  n_steps: 64\n"
         '  batch_size: 64\n  n_epochs: 1\n  policy_kwargs: "dict(net_arch=[8])"\n'
     )
     run = tmp_path / "run"
-    train(TrainConfig("ppo", "SGCPoint-v0", seed=3, timesteps=128, out=run, hyperparams_dir=hp))
+    train(TrainConfig("ppo", "SGCPoint-v1", seed=3, timesteps=128, out=run, hyperparams_dir=hp))
     row = _seed_table().seed_row(run, episodes=1, seed=20_000)
-    assert row["seed"] == 3 and row["steps"] == 128 and row["env_id"] == "SGCPoint-v0"
+    assert row["seed"] == 3 and row["steps"] == 128 and row["env_id"] == "SGCPoint-v1"
     assert row["n_goals"] == 3 and 0 <= row["goals_met"] <= 3
     config = json.loads((run / "config.json").read_text())
     assert row["wall_time_s"] == round(config["wall_time_s"], 1)  # 0.0 where 128 steps are fast
@@ -81,7 +81,7 @@ def test_seed_table_reads_a_benchmark_score_only_for_the_seeds_asked(tmp_path: P
     measured on other held-out seeds or episodes."""
     (tmp_path / "final_model.zip").write_bytes(b"")
     (tmp_path / "config.json").write_text(json.dumps({
-        "env_id": "SGCRod-v0", "seed": 4, "timesteps": 1000, "wall_time_s": 12.3,
+        "env_id": "SGCRod-v1", "seed": 4, "timesteps": 1000, "wall_time_s": 12.3,
         "learn_time_s": 10.0}))  # fmt: skip
     final = {"goals_met": 121, "n_goals": 150, "success_rate": 121 / 150}
     (tmp_path / "result.json").write_text(json.dumps({
@@ -99,7 +99,7 @@ def test_the_raw_observation_rows_copy_their_ppo_rows_but_the_features() -> None
 
     hp = ROOT / "benchmarks" / "hyperparams"
     raw = yaml.safe_load((hp / "ppo_raw" / "ppo.yml").read_text())
-    for env_id, folder in (("SGCRod-v0", "ppo_rod300"), ("SGCPoint-v0", "ppo_rod_alive64")):
+    for env_id, folder in (("SGCRod-v1", "ppo_rod300"), ("SGCPoint-v1", "ppo_rod_alive64")):
         ppo = yaml.safe_load((hp / folder / "ppo.yml").read_text())[env_id]
         copy = raw[env_id]
         skip = {"n_timesteps", "policy_kwargs"}  # a budget cap; the features extractor

@@ -19,8 +19,8 @@ def a_file(tmp_path) -> Path:
     return path
 
 
-DEMOS = ["demos", "--env", "SGCPoint-v0", "--episodes", "1"]
-TRAIN = ["train", "--algo", "ppo", "--env", "SGCPoint-v0"]
+DEMOS = ["demos", "--env", "SGCPoint-v1", "--episodes", "1"]
+TRAIN = ["train", "--algo", "ppo", "--env", "SGCPoint-v1"]
 
 # (argv with {file} for a plain file and {tmp} for a folder, fragment of the one-line error)
 BAD = [
@@ -96,7 +96,7 @@ def test_interrupted_evaluate_keeps_the_earlier_results(tmp_path, monkeypatch, c
     from baselines.cli.commands import evaluate as command
 
     out = tmp_path / "ev"
-    argv = ["evaluate", "--env", "SGCPoint-v0", "--episodes", "1", "--no-plots", "--out", str(out)]
+    argv = ["evaluate", "--env", "SGCPoint-v1", "--episodes", "1", "--no-plots", "--out", str(out)]
     assert cli.main([*argv, "--seed", "1"]) == 0
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     write = command._write_pair

@@ -13,7 +13,7 @@ from baselines.cli.main import build_parser, main
 
 def test_evaluate_fits_80_columns(tmp_path, capsys, monkeypatch) -> None:
     monkeypatch.setenv("COLUMNS", "80")
-    argv = ["evaluate", "--env", "SGCIntercept-v0", "--policy", "expert,dynamic-constraints",
+    argv = ["evaluate", "--env", "SGCIntercept-v1", "--policy", "expert,dynamic-constraints",
             "--episodes", "1", "--no-plots", "--out", str(tmp_path)]  # fmt: skip
     assert main(argv) == 0
     out = capsys.readouterr().out
@@ -27,7 +27,7 @@ def test_evaluate_fits_80_columns(tmp_path, capsys, monkeypatch) -> None:
 
 def test_single_pair_ends_with_one_summary_line(tmp_path, capsys, monkeypatch) -> None:
     monkeypatch.setenv("COLUMNS", "80")
-    argv = ["evaluate", "--env", "SGCRod-v0", "--episodes", "1", "--no-plots",
+    argv = ["evaluate", "--env", "SGCRod-v1", "--episodes", "1", "--no-plots",
             "--out", str(tmp_path)]  # fmt: skip
     assert main(argv) == 0
     last = capsys.readouterr().out.strip().splitlines()[-1]
@@ -49,7 +49,7 @@ def test_summary_line_reads_flattened_histories() -> None:
     [("ppo", 5000, 6144), ("ppo", 2048, 2048), ("sac", 1001, 1001), ("ppo", 0, 0)],
 )
 def test_timesteps_round_up_to_whole_rollouts(algo, asked, trained) -> None:
-    assert whole_rollouts(asked, algo, load_hyperparams(algo, "SGCPoint-v0")) == trained
+    assert whole_rollouts(asked, algo, load_hyperparams(algo, "SGCPoint-v1")) == trained
 
 
 def _help(command: str, capsys: pytest.CaptureFixture[str]) -> str:

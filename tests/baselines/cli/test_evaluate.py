@@ -30,7 +30,7 @@ def _importable_commands(monkeypatch):
 
 def test_evaluate_writes_table_files_and_plots(tmp_path, capsys):
     out = tmp_path / "ev"
-    argv = ["evaluate", "--env", "SGCPoint-v0", "--policy", "expert", "--episodes", "1"]
+    argv = ["evaluate", "--env", "SGCPoint-v1", "--policy", "expert", "--episodes", "1"]
     assert cli.main([*argv, "--seed", "7", "--out", str(out)]) == 0
     with (out / "goals.csv").open() as handle:
         reader = csv.DictReader(handle)
@@ -41,21 +41,21 @@ def test_evaluate_writes_table_files_and_plots(tmp_path, capsys):
     assert summary["episodes"] == 1 and summary["seed"] == 7
     assert (out / "goal_errors.png").stat().st_size > 0
     assert (out / "speed_profile.png").stat().st_size > 0
-    assert "SGCPoint-v0" in capsys.readouterr().out
+    assert "SGCPoint-v1" in capsys.readouterr().out
 
 
 def test_evaluate_compares_policies(tmp_path, capsys):
     out = tmp_path / "cmp"
-    argv = ["evaluate", "--env", "SGCPoint-v0", "--policy", "expert,random", "--policy"]
+    argv = ["evaluate", "--env", "SGCPoint-v1", "--policy", "expert,random", "--policy"]
     assert (
         cli.main([*argv, "minimum-jerk", "--episodes", "1", "--no-plots", "--out", str(out)]) == 0
     )
     cards = json.loads((out / "scorecard.json").read_text())
     assert [c["policy"] for c in cards] == ["expert", "random", "minimum-jerk"]
     table = (out / "scorecard.md").read_text()
-    assert table.count("\n") == 2 + 3 and "| SGCPoint-v0 | random |" in table
+    assert table.count("\n") == 2 + 3 and "| SGCPoint-v1 | random |" in table
     for name in ("expert", "random", "minimum-jerk"):
-        assert (out / "SGCPoint-v0" / name / "goals.csv").is_file()
+        assert (out / "SGCPoint-v1" / name / "goals.csv").is_file()
     assert "random" in capsys.readouterr().out
 
 
@@ -71,7 +71,7 @@ def test_evaluate_picks_the_reward_mode(tmp_path, capsys):
     returns = {}
     for mode in ("sparse", "distance"):
         out = tmp_path / mode
-        argv = ["evaluate", "--env", "SGCPoint-v0", "--policy", "expert", "--episodes", "1",
+        argv = ["evaluate", "--env", "SGCPoint-v1", "--policy", "expert", "--episodes", "1",
                 "--reward", mode, "--no-plots", "--out", str(out)]  # fmt: skip
         assert cli.main(argv) == 0
         returns[mode] = json.loads((out / "summary.json").read_text())["return_mean"]
@@ -82,19 +82,19 @@ def test_evaluate_picks_the_reward_mode(tmp_path, capsys):
 
 
 def test_evaluate_keeps_models_with_the_same_file_name_apart(tmp_path, capsys):
-    shipped = SHIPPED / "ppo_dagger_SGCPoint-v0.zip"
+    shipped = SHIPPED / "ppo_dagger_SGCPoint-v1.zip"
     specs = []
     for run in ("run_a", "run_b"):
         (tmp_path / run).mkdir()
         specs.append(str(tmp_path / run / "final_model.zip"))
         shutil.copy(shipped, specs[-1])
     out = tmp_path / "cmp"
-    argv = ["evaluate", "--env", "SGCPoint-v0", "--policy", ",".join(specs), "--episodes", "1"]
+    argv = ["evaluate", "--env", "SGCPoint-v1", "--policy", ",".join(specs), "--episodes", "1"]
     assert cli.main([*argv, "--no-plots", "--out", str(out)]) == 0
     cards = json.loads((out / "scorecard.json").read_text())
     assert [c["policy"] for c in cards] == ["run_a-final_model", "run_b-final_model"]
     for label in ("run_a-final_model", "run_b-final_model"):
-        assert (out / "SGCPoint-v0" / label / "goals.csv").is_file()
+        assert (out / "SGCPoint-v1" / label / "goals.csv").is_file()
     assert cli.main([*argv[:4], f"{specs[0]},{specs[0]}", "--out", str(out)]) == 2
     assert "given more than once" in capsys.readouterr().err
 
@@ -112,7 +112,7 @@ def test_rollout_writes_trajectory_and_figures(tmp_path):
 
 def test_rollout_from_env_seed_with_another_controller(tmp_path):
     out = tmp_path / "ro2"
-    argv = ["rollout", "--env", "SGCRod-v0", "--seed", "4", "--policy", "minimum-jerk"]
+    argv = ["rollout", "--env", "SGCRod-v1", "--seed", "4", "--policy", "minimum-jerk"]
     assert cli.main([*argv, "--no-compare", "--out", str(out)]) == 0
     assert not (out / "figure1_vs_2.png").exists()
     assert (out / "deviation.png").is_file()
@@ -123,7 +123,7 @@ def test_rollout_writes_the_motion_as_gltf_when_asked(tmp_path):
     from tests.sgc_env.export.glb_reader import read_glb
 
     out = tmp_path / "ro3"
-    argv = ["rollout", "--env", "SGCRod-v0", "--seed", "4", "--gltf", "--no-compare"]
+    argv = ["rollout", "--env", "SGCRod-v1", "--seed", "4", "--gltf", "--no-compare"]
     assert cli.main([*argv, "--out", str(out)]) == 0
     glb = read_glb(out / "rollout.glb")
     data = np.load(out / "trajectory.npz")

@@ -21,7 +21,7 @@ def _error(argv: list[str], capsys: pytest.CaptureFixture) -> str:
     return err
 
 
-BASE = ("SGCPoint-v0:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_steps: 64\n"
+BASE = ("SGCPoint-v1:\n  n_timesteps: 64\n  policy: MlpPolicy\n  n_steps: 64\n"
         "  batch_size: 64\n  n_epochs: 1\n")  # fmt: skip
 
 #: hyperparameter file -> fragment of the error (each line replaces or extends BASE)
@@ -49,7 +49,7 @@ def test_bad_hyperparameters_exit_2_naming_the_field(
     key = line.split(":")[0]
     body = "".join(row for row in BASE.splitlines(keepends=True) if row.split(":")[0] != key)
     (tmp_path / "ppo.yml").write_text(body + line)
-    argv = ["train", "--algo", "ppo", "--env", "SGCPoint-v0", "--timesteps", "64",
+    argv = ["train", "--algo", "ppo", "--env", "SGCPoint-v1", "--timesteps", "64",
             "--hyperparams", str(tmp_path)]  # fmt: skip
     assert HYPERPARAMS[line] in _error(argv, capsys)
 
@@ -69,7 +69,7 @@ def test_bad_env_kwargs_exit_2_before_any_work(
 ) -> None:
     argv = {"demos": ["demos", "--episodes", "1", "--out", str(tmp_path / "d.npz")],
             "train": ["train", "--algo", "ppo", "--timesteps", "64"]}[command]  # fmt: skip
-    err = _error([*argv, "--env", "SGCPoint-v0", "--env-kwargs", kwargs], capsys)
+    err = _error([*argv, "--env", "SGCPoint-v1", "--env-kwargs", kwargs], capsys)
     assert ENV_KWARGS[kwargs] in err
     assert list(tmp_path.iterdir()) == []
 
@@ -80,7 +80,7 @@ RECIPES = {
     "{algo: ppo, train: {bc_epochs: x}}": "train option bc_epochs must be an integer",
     "{algo: ppo, train: {init: bc, demos: 5}}": "train option demos must be a string",
     "{algo: ppo, train: {demos: '{env_id.__class__}'}}": "the only placeholders are",
-    "{algo: ppo, env_kwargs: {foo: 1}}": "env_kwargs: SGCPoint-v0 does not take {'foo': 1}",
+    "{algo: ppo, env_kwargs: {foo: 1}}": "env_kwargs: SGCPoint-v1 does not take {'foo': 1}",
     "{algo: [ppo]}": "algo must be one of",
     "[1, 2]": "expected a mapping, got list",
     "{algo: ppo}\n\t- tab": "not valid YAML: while scanning",
@@ -93,7 +93,7 @@ def test_bad_recipes_exit_2_naming_the_recipe(
 ) -> None:
     recipes = tmp_path / "r.yml"
     recipes.write_text(f"recipes:\n  - {entry}\n")
-    argv = ["benchmark", "--recipes", str(recipes), "--env", "SGCPoint-v0", "--seeds", "1",
+    argv = ["benchmark", "--recipes", str(recipes), "--env", "SGCPoint-v1", "--seeds", "1",
             "--out", str(tmp_path / "out"), "--no-plots"]  # fmt: skip
     assert RECIPES[entry] in _error(argv, capsys) and not (tmp_path / "out").exists()
 

@@ -63,7 +63,7 @@ def _goal_errors(venv: Any, policy: Any, seeds: list[int]) -> list[float]:
 
 @pytest.mark.parametrize("kind", list(VECTORS))
 def test_expert_meets_goals_on_every_vector_env(kind: str) -> None:
-    venv = VECTORS[kind]("SGCIntercept-v0")
+    venv = VECTORS[kind]("SGCIntercept-v1")
     try:
         assert base_env(venv, 1).scenario.name == "intercept"
         errors = _goal_errors(venv, SGCExpert(venv), [3, 4])
@@ -76,7 +76,7 @@ def test_expert_meets_goals_on_every_vector_env(kind: str) -> None:
 @pytest.mark.parametrize("kind", ["SubprocVecEnv", "AsyncVectorEnv"])
 def test_episode_expert_reads_each_process_scenario(kind: str) -> None:
     """Random scenarios differ per sub-env; the per-episode expert reads each one's model."""
-    venv = VECTORS[kind]("SGCPoint-v0")
+    venv = VECTORS[kind]("SGCPoint-v1")
     try:
         errors = _goal_errors(venv, make_policy("expert", venv), [5, 6])
     finally:

@@ -16,7 +16,7 @@ from baselines.controllers.comparison_policies import (
 )
 
 EXACT = 1e-9
-FLAT_LEARNER_IDS = [k for k in sgc_env.LEARNER_IDS if "Goal" not in k]
+FLAT_IDS = [k for k in sgc_env.ENV_IDS if "Goal" not in k]
 """The newest ids with a flat observation (the comparisons read no goal-conditioned Dict)."""
 
 
@@ -35,7 +35,7 @@ def _episode(env: Any, policy: Any, seed: int) -> tuple[list[np.ndarray], list[d
             return actions, events, bool(terminated)
 
 
-@pytest.mark.parametrize("env_id", FLAT_LEARNER_IDS)
+@pytest.mark.parametrize("env_id", FLAT_IDS)
 def test_minimum_jerk_is_exact_on_the_newest_ids(env_id: str) -> None:
     env = gym.make(env_id)
     _, events, failed = _episode(env, MinimumJerkController(env), seed=3)
@@ -46,7 +46,7 @@ def test_minimum_jerk_is_exact_on_the_newest_ids(env_id: str) -> None:
         assert e["orientation_error"] is None or e["orientation_error"] <= EXACT, e
 
 
-@pytest.mark.parametrize("env_id", FLAT_LEARNER_IDS)
+@pytest.mark.parametrize("env_id", FLAT_IDS)
 def test_dynamic_constraints_acts_as_on_the_planner_version(env_id: str) -> None:
     """Its actions over an episode are, bit for bit, those on the planner's view of the id
     (its goals are met only to its eps: the method's own pathology, not a view's)."""

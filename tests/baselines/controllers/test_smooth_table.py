@@ -28,7 +28,7 @@ def _scenario(env_id: str, seed: int):
 
 
 def test_every_real_goal_is_a_sub_goal_on_the_reference():
-    scenario = _scenario("SGCThreeRods-v1", 0)
+    scenario = _scenario("SGCThreeRods-v2", 0)
     table = smooth_table(scenario)
     from sgc_env.envs.tracks import compile_tracks
 
@@ -50,9 +50,9 @@ def test_every_real_goal_is_a_sub_goal_on_the_reference():
 
 
 def test_expert_smooth_meets_every_goal_within_2x_of_minimum_jerk_on_a_rod():
-    """One SGCRod-v0 episode (seconds): goals exact, both kinks within 2x minimum jerk's."""
-    smooth = evaluate("expert-smooth", "SGCRod-v0", 1, 10000, keep_infos=0).episodes[0]
-    reference = evaluate("minimum-jerk", "SGCRod-v0", 1, 10000, keep_infos=0).episodes[0]
+    """One SGCRod-v1 episode (seconds): goals exact, both kinks within 2x minimum jerk's."""
+    smooth = evaluate("expert-smooth", "SGCRod-v1", 1, 10000, keep_infos=0).episodes[0]
+    reference = evaluate("minimum-jerk", "SGCRod-v1", 1, 10000, keep_infos=0).episodes[0]
     card, ref = smooth.card["bodies"][0], reference.card["bodies"][0]
     assert card["goals_met"] == card["n_goals"]
     assert card["position_error_max"] < GOAL_TOLERANCE
@@ -62,12 +62,12 @@ def test_expert_smooth_meets_every_goal_within_2x_of_minimum_jerk_on_a_rod():
 
 
 def test_expert_smooth_needs_its_scenario_and_falls_back_on_another():
-    env = gym.make("SGCRod-v0")
+    env = gym.make("SGCRod-v1")
     model = SGCExpert(env).model
     with pytest.raises(ValueError, match="needs the env or the episode's scenario"):
         SGCExpert(model=model, end_rule="smooth")
     obs, _ = env.reset(seed=4)
-    other = _scenario("SGCRod-v0", 5)  # none of this episode's courses is in its table
+    other = _scenario("SGCRod-v1", 5)  # none of this episode's courses is in its table
     stranger = SGCExpert(model=model, end_rule="smooth", scenario=other)
     tangent = SGCExpert(model=model, end_rule="tangent")
     np.testing.assert_array_equal(stranger.action(obs), tangent.action(obs))
@@ -81,7 +81,7 @@ def test_expert_smooth_absorbs_a_push():
     is still met exactly."""
     from baselines.policies import make_policy
 
-    env = gym.make("SGCRod-v0")
+    env = gym.make("SGCRod-v1")
     obs, _ = env.reset(seed=10000)
     policy = make_policy("expert-smooth", env)
     errors, tick, done = [], 0, False

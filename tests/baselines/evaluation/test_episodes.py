@@ -34,10 +34,10 @@ def _without_wall_time(summary):
 @pytest.mark.parametrize(
     ("env_id", "policy", "episodes", "num_envs"),
     [
-        ("SGCRod-v0", "expert", 5, 3),  # more episodes than sub-envs: sub-envs are reused
-        ("SGCIntercept-v0", "minimum-jerk", 3, 2),  # per-sub-env state in the policy
-        ("SGCInterceptRandom-v0", "dynamic-constraints", 3, 3),  # a scene drawn per reset
-        ("SGCPoint-v0", "expert", 4, 4),
+        ("SGCRod-v1", "expert", 5, 3),  # more episodes than sub-envs: sub-envs are reused
+        ("SGCIntercept-v1", "minimum-jerk", 3, 2),  # per-sub-env state in the policy
+        ("SGCInterceptRandom-v1", "dynamic-constraints", 3, 3),  # a scene drawn per reset
+        ("SGCPoint-v1", "expert", 4, 4),
     ],
 )
 def test_batched_episodes_equal_single_env_episodes(env_id, policy, episodes, num_envs):
@@ -57,7 +57,7 @@ def test_batched_episodes_equal_single_env_episodes(env_id, policy, episodes, nu
 
 
 def test_batched_episodes_cut_at_max_steps_like_single_episodes():
-    env = make_vec("SGCRod-v0", 2)
+    env = make_vec("SGCRod-v1", 2)
     try:
         policy = make_policy("expert", env)
         records = run_episodes_batched(policy, env, [1, 2, 3], max_steps=7)
@@ -68,7 +68,7 @@ def test_batched_episodes_cut_at_max_steps_like_single_episodes():
 
 
 def test_random_policy_acts_in_one_sub_envs_action_space():
-    result = evaluate("random", "SGCRod-v0", 3, seed=5, num_envs=3)
+    result = evaluate("random", "SGCRod-v1", 3, seed=5, num_envs=3)
     assert result.summary["episodes"] == 3 and result.summary["steps"] > 0
 
 
@@ -81,11 +81,11 @@ def test_sub_info_reads_masked_keys():
 @pytest.mark.parametrize("bad", [0, -1, 1.5, True])
 def test_num_envs_is_checked(bad):
     with pytest.raises(ValueError, match="num_envs"):
-        evaluate("expert", "SGCPoint-v0", 2, seed=0, num_envs=bad)
+        evaluate("expert", "SGCPoint-v1", 2, seed=0, num_envs=bad)
 
 
 def test_more_sub_envs_than_episodes_is_refused_by_the_runner():
-    env = make_vec("SGCPoint-v0", 3)
+    env = make_vec("SGCPoint-v1", 3)
     try:
         with pytest.raises(ValueError, match="at most one sub-env per episode"):
             run_episodes_batched(make_policy("expert", env), env, [0, 1])
@@ -95,7 +95,7 @@ def test_more_sub_envs_than_episodes_is_refused_by_the_runner():
 
 def test_cli_num_envs(tmp_path):
     out = subprocess.run(
-        [sys.executable, "-m", "baselines.cli.main", "evaluate", "--env", "SGCPoint-v0",
+        [sys.executable, "-m", "baselines.cli.main", "evaluate", "--env", "SGCPoint-v1",
          "--episodes", "3", "--num-envs", "2", "--no-plots", "--out", str(tmp_path / "e")],
         capture_output=True, text=True, check=False,
     )  # fmt: skip

@@ -22,7 +22,7 @@ from sgc_env.scenes import three_rods
 from sgc_env.simulator import pybullet
 from tests.sgc_env.export.glb_reader import read_glb
 
-ROD_MODEL = Path(__file__).resolve().parents[3] / "baselines/checkpoints/ppo_dagger_SGCRod-v0.zip"
+ROD_MODEL = Path(__file__).resolve().parents[3] / "baselines/checkpoints/ppo_dagger_SGCRod-v1.zip"
 """A shipped model of the one-rod env (6 actions): it does not fit the three rods (18)."""
 OUTPUTS = {
     "three_rods.mp4", "three_rods.gif", "plates.png", "deviation.png", "speed.png", "goals.csv",
@@ -35,7 +35,7 @@ MIN_SPEED_FRACTION = 0.1
 
 @pytest.fixture(scope="module")
 def episode():
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     record = run_episode(SGCExpert(env), env, seed=0, keep_infos=True)
     scenario = env.unwrapped.scenario
     env.close()
@@ -232,7 +232,7 @@ def test_demo_compare_writes_both_runs_side_by_side(tmp_path, capsys):
     [
         (["--policy", "nonsense"], "unknown spec 'nonsense'"),
         (["--policy", str(ROD_MODEL)], "does not fit"),
-        (["--policy", "shipped:SGCPoint-v0"], "(trained on SGCPoint-v0)"),
+        (["--policy", "shipped:SGCPoint-v1"], "(trained on SGCPoint-v1)"),
         (["--policy", "random", "--paper-rule"], "--paper-rule: applies to the expert"),
         (["--compare", "expert"], "expected two specs"),
         (["--compare", "expert,random", "--no-video"], "drop --no-video"),
@@ -277,7 +277,7 @@ def test_a_ball_the_tip_never_meets_is_not_pierced(episode):
 
 
 def test_pierced_balls_ride_their_rods_and_missed_ones_fly_on():
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     _, info = env.reset(seed=0)
     base = env.unwrapped
     with pytest.raises(ValueError, match="one time per rod"):

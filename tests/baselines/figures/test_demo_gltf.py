@@ -26,7 +26,7 @@ def demo(tmp_path_factory):
     result = run_demo(DemoOptions(out=out, video=False))
     import gymnasium as gym
 
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     record = run_episode(SGCExpert(env), env, seed=0, keep_infos=True)  # the env's own numbers
     scenario = env.unwrapped.scenario
     env.close()

@@ -97,7 +97,7 @@ def test_blender_imports_the_three_rods_keyframed_where_the_env_put_them(demo_gl
     from baselines.controllers.expert import SGCExpert
     from baselines.evaluation.harness import run_episode
 
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     record = run_episode(SGCExpert(env), env, seed=0, keep_infos=True)
     names = [b.name for b in env.unwrapped.scenario.bodies]
     assert sorted(objects) == sorted(f"expert/{n}" for n in names)
@@ -134,7 +134,7 @@ def test_the_viewer_page_shows_the_three_rods_in_chromium(demo_glb, tmp_path):
     import imageio.v2 as imageio
 
     image = imageio.imread(shot)[..., :3].astype(int)
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     env.reset(seed=0)
     for body in env.unwrapped.scenario.bodies:  # each rod's hue shows on some pixels
         want = np.asarray(body.color[:3]) * 255

@@ -40,7 +40,7 @@ class Payload:
         return (os.system, (f"touch '{self.marker}'",))
 
 
-def _clean_model(path: Path, env_id: str = "SGCPoint-v0") -> Path:
+def _clean_model(path: Path, env_id: str = "SGCPoint-v1") -> Path:
     from stable_baselines3 import PPO
 
     env = gym.make(env_id)
@@ -82,12 +82,12 @@ def _pickled_weights_model(clean: Path, target: Path, marker: Path) -> Path:
 
 
 def _evaluate(policy: Path, tmp: Path, *extra: str) -> int:
-    return cli.main(["evaluate", "--policy", str(policy), "--env", "SGCPoint-v0", "--episodes",
+    return cli.main(["evaluate", "--policy", str(policy), "--env", "SGCPoint-v1", "--episodes",
                      "1", "--no-plots", "--out", str(tmp / "ev"), *extra])  # fmt: skip
 
 
 def _rollout(policy: Path, tmp: Path, *extra: str) -> int:
-    return cli.main(["rollout", "--policy", str(policy), "--env", "SGCPoint-v0", "--no-compare",
+    return cli.main(["rollout", "--policy", str(policy), "--env", "SGCPoint-v1", "--no-compare",
                      "--out", str(tmp / "ro"), *extra])  # fmt: skip
 
 
@@ -104,17 +104,17 @@ def clean_models(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """A clean model per env the commands run on: the point for evaluate and rollout, the
     three rods for the demo."""
     folder = tmp_path_factory.mktemp("clean")
-    return {"SGCPoint-v0": _clean_model(folder / "model.zip"),
-            "SGCThreeRods-v1": _clean_model(folder / "rods.zip", "SGCThreeRods-v1")}  # fmt: skip
+    return {"SGCPoint-v1": _clean_model(folder / "model.zip"),
+            "SGCThreeRods-v2": _clean_model(folder / "rods.zip", "SGCThreeRods-v2")}  # fmt: skip
 
 
 @pytest.fixture(scope="module")
 def clean(clean_models: dict[str, Path]) -> Path:
-    return clean_models["SGCPoint-v0"]
+    return clean_models["SGCPoint-v1"]
 
 
 def _clean_for(command: str, clean_models: dict[str, Path]) -> Path:
-    return clean_models["SGCThreeRods-v1" if command == "demo" else "SGCPoint-v0"]
+    return clean_models["SGCThreeRods-v2" if command == "demo" else "SGCPoint-v1"]
 
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
@@ -197,7 +197,7 @@ def _shadowing_field(clean: Path, tmp: Path) -> Path:
 
 
 def _other_env(clean: Path, tmp: Path) -> Path:
-    return SHIPPED / "ppo_dagger_SGCRod-v0.zip"  # trained on the rod: 6 actions, not 3
+    return SHIPPED / "ppo_dagger_SGCRod-v1.zip"  # trained on the rod: 6 actions, not 3
 
 
 def _wrong_statistics(clean: Path, tmp: Path) -> Path:
@@ -238,16 +238,16 @@ def test_malformed_model_files_exit_2_naming_file_and_problem(
 def test_shipped_model_on_the_wrong_env_names_the_env_it_was_trained_on(
     tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
-    argv = ["evaluate", "--policy", "shipped:SGCPoint-v0", "--env", "SGCRod-v0", "--episodes",
+    argv = ["evaluate", "--policy", "shipped:SGCPoint-v1", "--env", "SGCRod-v1", "--episodes",
             "1", "--no-plots", "--out", str(tmp_path)]  # fmt: skip
     assert cli.main(argv) == 2
-    assert "(trained on SGCPoint-v0)" in capsys.readouterr().err
+    assert "(trained on SGCPoint-v1)" in capsys.readouterr().err
 
 
 def test_safe_and_trusted_loading_predict_alike(clean: Path) -> None:
     from baselines.models.model_files import load_sb3_model
 
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     obs, _ = env.reset(seed=3)
     safe = load_sb3_model(clean, env=env)
     trusted = load_sb3_model(clean, env=env, trust_model=True)
@@ -263,8 +263,8 @@ def test_shipped_models_hold_no_pickle_beside_them() -> None:
     assert not list(SHIPPED.glob("*.pkl"))
     assert sorted(p.name for p in SHIPPED.glob("*.vecnormalize.json")) == [
         "ppo_caps_SGCThreeRodsRandom-v3.vecnormalize.json",
-        "ppo_point500k_SGCPoint-v0.vecnormalize.json", "ppo_rod300_SGCRod-v0.vecnormalize.json",
-        "ppo_schedule_SGCPoint-v0.vecnormalize.json", "ppo_schedule_SGCRod-v0.vecnormalize.json",
+        "ppo_point500k_SGCPoint-v1.vecnormalize.json", "ppo_rod300_SGCRod-v1.vecnormalize.json",
+        "ppo_schedule_SGCPoint-v1.vecnormalize.json", "ppo_schedule_SGCRod-v1.vecnormalize.json",
     ]  # fmt: skip
 
 

@@ -32,7 +32,7 @@ from tests.baselines.models.pd_law import set_pd_law  # noqa: E402
 
 RECIPE = Path(__file__).resolve().parents[3] / "benchmarks" / "hyperparams" / "ppo_threerod"
 RANDOM_ID = next(i for i in sgc_env.ENV_IDS if i.startswith("SGCThreeRodsRandom-"))
-PAPER_ID = "SGCThreeRods-v1"
+PAPER_ID = "SGCThreeRods-v2"
 SHARED = ("mlp_extractor.", "action_net.linear.", "value_net.linear.", "log_std")
 
 
@@ -62,7 +62,7 @@ def test_shapes_and_one_log_std_per_action_component() -> None:
 @pytest.mark.parametrize("skip", [False, True])
 def test_it_is_the_single_body_net_applied_per_body(skip: bool) -> None:
     three = _model(RANDOM_ID, skip=skip).policy
-    one = _model("SGCRod-v0", skip=skip).policy
+    one = _model("SGCRod-v1", skip=skip).policy
     assert three.action_net.linear.in_features == 16 + BODY_FEATURES * skip
     shared = {k: v for k, v in three.state_dict().items() if k.startswith(SHARED)}
     assert shared and all(v.shape == one.state_dict()[k].shape for k, v in shared.items())
@@ -88,8 +88,8 @@ def test_it_is_the_single_body_net_applied_per_body(skip: bool) -> None:
 
 
 def test_gains_follow_the_limits_the_agent_does_not_observe() -> None:
-    rod_gain, rod_offset = body_gains(gym.make("SGCRod-v0"))
-    assert np.allclose(rod_gain, 1.0, rtol=0.02)  # the reference is SGCRod-v0's own scale
+    rod_gain, rod_offset = body_gains(gym.make("SGCRod-v1"))
+    assert np.allclose(rod_gain, 1.0, rtol=0.02)  # the reference is SGCRod-v1's own scale
     assert rod_offset[0, 2] == pytest.approx(9.81 / 100.0) and not rod_offset[0, 3:].any()
     paper, _ = body_gains(gym.make(PAPER_ID))
     drawn, _ = body_gains(gym.make(RANDOM_ID))
@@ -99,9 +99,9 @@ def test_gains_follow_the_limits_the_agent_does_not_observe() -> None:
     limit = env.scenario.bodies[0].force_limit
     assert paper[0, 0] == pytest.approx(REFERENCE_ACCELERATION * 1.0 / limit)
     with pytest.raises(ValueError, match="built for 1 bodies, the env has 3"):
-        _model("SGCRod-v0").policy.bind_env(gym.make(PAPER_ID))
+        _model("SGCRod-v1").policy.bind_env(gym.make(PAPER_ID))
     with pytest.raises(ValueError, match="6 actions per body"):
-        body_gains(gym.make("SGCPoint-v0"))
+        body_gains(gym.make("SGCPoint-v1"))
 
 
 def test_a_saved_model_flies_the_paper_scene_with_that_scenes_gains(tmp_path: Path) -> None:
@@ -150,7 +150,7 @@ def test_the_shipped_model_flies_the_paper_scene() -> None:
     fixed and the policy deterministic."""
     from baselines.zoo.manifest import CHECKPOINTS, load_manifest
 
-    name = "ppo_perbody_SGCThreeRodsRandom-v2.zip"
+    name = "ppo_perbody_SGCThreeRodsRandom-v3.zip"
     entry = next(e for e in load_manifest(CHECKPOINTS) if e["file"] == name)
     assert entry["demonstrations"] is False and entry["timesteps"] > 0
     summary = evaluate(str(CHECKPOINTS / name), PAPER_ID, 1, 20_000).summary

@@ -70,7 +70,7 @@ def test_it_is_the_one_rod_net_applied_per_body() -> None:
 
 def test_a_planner_view_or_a_wrong_size_is_refused_clearly() -> None:
     with pytest.raises(ValueError, match="LearnerViewBodies needs the learner view"):
-        _model("SGCThreeRodsRandom-v2")
+        _model("SGCThreeRodsRandom-v3")
     with pytest.raises(ValueError, match="LearnerViewBodies needs the learner view"):
         LearnerViewBodies(gym.spaces.Box(-1, 1, (10,), np.float32))
 
@@ -98,7 +98,7 @@ def test_the_recipes_name_the_view_and_the_newest_random_id(recipe: str) -> None
     assert kwargs["features_extractor_class"] is LearnerViewBodies
     assert hp.reward_shaping == "none"
     smooth = recipe == "ppo_threerod_smooth"
-    assert (training_class(hp) is SmoothPPO) == smooth and hp.action_rate == 0
+    assert (training_class(hp) is SmoothPPO) == smooth
 
 
 def test_the_demo_flies_each_model_on_the_version_of_the_scene_it_observes(tmp_path: Path) -> None:
@@ -107,7 +107,7 @@ def test_the_demo_flies_each_model_on_the_version_of_the_scene_it_observes(tmp_p
     learner = tmp_path / "learner.zip"
     _model(RANDOM_ID, net_arch=[]).save(learner)
     assert demo_env_id(DemoOptions(out=tmp_path, policy=str(learner))) == PAPER_ID
-    assert demo_env_id(DemoOptions(out=tmp_path, policy="expert")) == "SGCThreeRods-v1"
+    assert demo_env_id(DemoOptions(out=tmp_path, policy="expert")) == "SGCThreeRods-v2"
     rod = tmp_path / "rod.zip"
     PPO("MlpPolicy", gym.make(ROD_ID), n_steps=64, batch_size=64).save(rod)
     with pytest.raises(ValueError, match=r"rod.zip.*does not fit"):

@@ -29,7 +29,7 @@ def test_every_shipped_model_has_a_card_with_the_manifest_facts():
 
 
 def test_card_reports_its_own_evaluation_apart_from_the_manifest():
-    entry = {"file": "ppo_x_SGCPoint-v0.zip", "env_id": "SGCPoint-v0", "algo": "ppo",
+    entry = {"file": "ppo_x_SGCPoint-v1.zip", "env_id": "SGCPoint-v1", "algo": "ppo",
              "demonstrations": False, "timesteps": 300000, "seed": 2, "wall_time_s": 489.7,
              "command": "sgc train --hyperparams benchmarks/hyperparams/ppo_schedule",
              "result": {"episodes": 50, "seed": 20000, "n_goals": 150, "goals_met": 150,

@@ -35,7 +35,7 @@ def test_manifest_entries_are_consistent() -> None:
     import sgc_env
 
     for entry in ENTRIES:
-        assert entry["env_id"] in sgc_env.ENV_IDS + sgc_env.LEARNER_IDS
+        assert entry["env_id"] in sgc_env.ENV_IDS
         assert entry["algo"] in ("ppo", "sac", "td3", "her")
         assert (
             entry["command"].startswith("sgc train")
@@ -84,13 +84,13 @@ def test_shipped_model_carries_its_normalisation(tmp_path: Path) -> None:
     hp = tmp_path / "hp"
     hp.mkdir()
     (hp / "ppo.yml").write_text(
-        "SGCPoint-v0:\n  n_timesteps: 128\n  policy: MlpPolicy\n  normalize: true\n"
+        "SGCPoint-v1:\n  n_timesteps: 128\n  policy: MlpPolicy\n  normalize: true\n"
         "  n_envs: 2\n  n_steps: 64\n  batch_size: 64\n  n_epochs: 1\n"
         '  policy_kwargs: "dict(net_arch=[8])"\n'
     )
     run = tmp_path / "run"
-    train(TrainConfig("ppo", "SGCPoint-v0", timesteps=128, out=run, hyperparams_dir=hp,
-                      command="sgc train --algo ppo --env SGCPoint-v0"))  # fmt: skip
+    train(TrainConfig("ppo", "SGCPoint-v1", timesteps=128, out=run, hyperparams_dir=hp,
+                      command="sgc train --algo ppo --env SGCPoint-v1"))  # fmt: skip
     folder = tmp_path / "ship"
     folder.mkdir()
     entry = ship_model(run, "tiny", which="final", episodes=1, seed=20_000, folder=folder)
@@ -99,9 +99,9 @@ def test_shipped_model_carries_its_normalisation(tmp_path: Path) -> None:
     alone = folder / "alone"
     alone.mkdir()
     shutil.copy(folder / "tiny.zip", alone / "tiny.zip")  # without its statistics
-    in_run = evaluate(str(run / "final_model.zip"), "SGCPoint-v0", 1, 20_000).summary
-    shipped = evaluate(str(folder / "tiny.zip"), "SGCPoint-v0", 1, 20_000).summary
-    bare = evaluate(str(alone / "tiny.zip"), "SGCPoint-v0", 1, 20_000).summary
+    in_run = evaluate(str(run / "final_model.zip"), "SGCPoint-v1", 1, 20_000).summary
+    shipped = evaluate(str(folder / "tiny.zip"), "SGCPoint-v1", 1, 20_000).summary
+    bare = evaluate(str(alone / "tiny.zip"), "SGCPoint-v1", 1, 20_000).summary
     assert shipped["position_error_mean"] == in_run["position_error_mean"]
     assert bare["position_error_mean"] != in_run["position_error_mean"]
 

@@ -53,7 +53,7 @@ def test_bad_actions_name_the_sub_env() -> None:
             vec.step(actions)
     # a refused step changed nothing: the next good step is the first one
     obs, *_ = vec.step(np.zeros((3, 3), np.float32))
-    single = gym.make("SGCPoint-v0", scenario="point_three_goals")
+    single = gym.make("SGCPoint-v1", scenario="point_three_goals")
     single.reset(seed=1)
     assert np.array_equal(obs[1], single.step(np.zeros(3, np.float32))[0])
     single.close()
@@ -87,7 +87,7 @@ def test_a_failing_sub_env_leaves_the_others_alone() -> None:
     """Sub-env 0 thrusts out of the workspace and resets; sub-env 1 (on the same nails, the
     three-rod scene, whose bodies collide with each other) steps as a single env would."""
     vec = SGCVectorEnv(2, scenario="three_rods")
-    single = gym.make("SGCThreeRods-v1")
+    single = gym.make("SGCThreeRods-v2")
     vec.reset(seed=0)
     o, _ = single.reset(seed=1)
     expert = SGCExpert(single)  # keeps sub-env 1 inside the workspace
@@ -106,7 +106,7 @@ def test_a_failing_sub_env_leaves_the_others_alone() -> None:
 
 def test_close_frees_the_client_and_cycles_leak_nothing() -> None:
     base = len(connected_clients())
-    vec = gym.make_vec("SGCIntercept-v0", num_envs=4, vectorization_mode="vector_entry_point")
+    vec = gym.make_vec("SGCIntercept-v1", num_envs=4, vectorization_mode="vector_entry_point")
     vec.reset(seed=0)
     # one client for the bodies of four sub-envs, one (never stepped) for their props
     assert len(connected_clients()) == base + 2
@@ -154,7 +154,7 @@ def test_a_step_holds_the_collector_off_and_leaves_it_as_it_was(
         return step(self, *args)  # type: ignore[arg-type]
 
     monkeypatch.setattr(batch_module.BatchTask, "step", watched)
-    env = gym.make_vec("SGCRod-v0", 12, vectorization_mode="vector_entry_point")
+    env = gym.make_vec("SGCRod-v1", 12, vectorization_mode="vector_entry_point")
     env.reset(seed=0)
     assert gc.isenabled()
     env.step(np.zeros(env.action_space.shape, np.float32))

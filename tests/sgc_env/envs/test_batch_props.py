@@ -21,7 +21,7 @@ def test_props_of_handed_out_sub_envs_are_where_single_envs_leave_them(
     fast_min: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(batch_module, "FAST_MIN_ENVS", fast_min)
-    env_id, n = "SGCThreeRodsRandom-v2", 2
+    env_id, n = "SGCThreeRodsRandom-v3", 2
     vec = gym.make_vec(env_id, n, vectorization_mode="vector_entry_point")
     singles = [gym.make(env_id).unwrapped for _ in range(n)]
     try:

@@ -34,7 +34,7 @@ def test_timers_count_resets_and_draws_then_restore(split):
 
 
 def test_tick_split_and_physics_floor_on_a_small_batch(split):
-    ms, env = split.tick_split("SGCRod-v0", 12, "batched", 4)
+    ms, env = split.tick_split("SGCRod-v1", 12, "batched", 4)
     try:
         assert ms["total"] >= ms["reset"] >= ms["draw"] >= 0.0
         assert ms["total"] > 0.0

@@ -52,7 +52,7 @@ def test_checkers_pass_with_warnings_as_errors(env_id):
         env.close()
 
 
-@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0", "SGCThreeRods-v1"])
+@pytest.mark.parametrize("env_id", ["SGCPoint-v1", "SGCRod-v1", "SGCThreeRods-v2"])
 def test_same_seed_same_rollout_bitwise(env_id):
     a, b = gym.make(env_id), gym.make(env_id)
     ra, rb = rollout(a, 7, 150), rollout(b, 7, 150)
@@ -62,7 +62,7 @@ def test_same_seed_same_rollout_bitwise(env_id):
 
 
 def test_seeded_then_plain_reset_is_deterministic():
-    a, b = gym.make("SGCPoint-v0"), gym.make("SGCPoint-v0")
+    a, b = gym.make("SGCPoint-v1"), gym.make("SGCPoint-v1")
     a.reset(seed=11)
     b.reset(seed=11)
     oa, _ = a.reset()
@@ -72,7 +72,7 @@ def test_seeded_then_plain_reset_is_deterministic():
 
 
 def test_random_scenario_changes_with_reset():
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     env.reset(seed=1)
     first = env.unwrapped.scenario
     env.reset()
@@ -83,7 +83,7 @@ def test_random_scenario_changes_with_reset():
 
 @pytest.mark.parametrize("mode", ["sync", "async"])
 def test_make_vec(mode):
-    envs = gym.make_vec("SGCRod-v0", num_envs=2, vectorization_mode=mode)
+    envs = gym.make_vec("SGCRod-v1", num_envs=2, vectorization_mode=mode)
     obs, _ = envs.reset(seed=3)
     assert obs.shape == (2, envs.single_observation_space.shape[0])
     for _ in range(5):
@@ -92,7 +92,7 @@ def test_make_vec(mode):
     envs.close()
 
 
-@pytest.mark.parametrize("env_id", ["SGCRod-v0", "SGCIntercept-v0", "SGCPointGoal-v0"])
+@pytest.mark.parametrize("env_id", ["SGCRod-v1", "SGCIntercept-v1", "SGCPointGoal-v1"])
 def test_pickle_continues_identically(env_id):
     env = gym.make(env_id).unwrapped
     env.reset(seed=5)
@@ -114,7 +114,7 @@ def test_pickle_continues_identically(env_id):
 
 
 def test_save_restore_state():
-    env = gym.make("SGCRod-v0").unwrapped
+    env = gym.make("SGCRod-v1").unwrapped
     env.reset(seed=2)
     env.action_space.seed(2)
     for _ in range(5):
@@ -375,7 +375,7 @@ def test_intercept_target_moves_kinematically():
 
 
 def test_goal_env_compute_reward_is_vectorised():
-    env = gym.make("SGCPointGoal-v0").unwrapped
+    env = gym.make("SGCPointGoal-v1").unwrapped
     obs, _ = env.reset(seed=0)
     a = np.stack([obs["desired_goal"], obs["achieved_goal"]])
     d = np.stack([obs["desired_goal"], obs["desired_goal"]])
@@ -383,7 +383,7 @@ def test_goal_env_compute_reward_is_vectorised():
 
 
 def test_goal_env_charges_the_steps_a_failure_leaves():
-    env = gym.make("SGCPointGoal-v0")
+    env = gym.make("SGCPointGoal-v1")
     env.reset(seed=0)
     base = env.unwrapped
     terminated = False
@@ -398,13 +398,13 @@ def test_goal_env_charges_the_steps_a_failure_leaves():
     relabelled = base.compute_reward(goal, goal, [info])
     assert relabelled.tolist() == [-float(left)]
     with pytest.raises(ValueError, match="reward modes apply to SGCEnv"):
-        gym.make("SGCPointGoal-v0", reward="sparse")
+        gym.make("SGCPointGoal-v1", reward="sparse")
 
 
 def test_goal_env_with_her():
     from stable_baselines3 import SAC, HerReplayBuffer
 
-    env = gym.make("SGCPointGoal-v0")
+    env = gym.make("SGCPointGoal-v1")
     model = SAC(
         "MultiInputPolicy", env, replay_buffer_class=HerReplayBuffer, learning_starts=300,
         batch_size=32,
@@ -458,7 +458,7 @@ def test_goals_of_every_body_are_reported_when_another_body_is_done():
 
 
 def test_one_env_id_check_names_the_field_and_the_ids():
-    assert sgc_env.check_env_id("SGCPoint-v0") == "SGCPoint-v0"
+    assert sgc_env.check_env_id("SGCPoint-v1") == "SGCPoint-v1"
     with pytest.raises(ValueError, match=r"^env: unknown environment 'Nope-v0'; SGC ids: \['SGCP"):
         sgc_env.check_env_id("Nope-v0", "env")
     with pytest.raises(ValueError, match="^env_id: unknown environment 3;"):
@@ -468,7 +468,7 @@ def test_one_env_id_check_names_the_field_and_the_ids():
 def test_dense_reward_is_its_documented_formula():
     """r = -(|D| / L + |phi| / A) - 0.01 mean(a^2) + goal bonuses, for one rod (L, A: the
     current course's start deviations, floored at 0.1 m and 0.5 rad): the "distance" mode."""
-    env = gym.make("SGCRod-v0", reward="distance")
+    env = gym.make("SGCRod-v1", reward="distance")
     obs, _ = env.reset(seed=3)
     lay = env.unwrapped.layout
     rng = np.random.default_rng(0)
@@ -499,7 +499,7 @@ def test_the_suite_closes_the_envs_a_test_leaves_open(close_envs):
     from tests.conftest import closing_every_env
 
     with closing_every_env() as made:
-        left_open = gym.make("SGCPoint-v0")
+        left_open = gym.make("SGCPoint-v1")
         closed = SGCEnv("point_three_goals")
         closed.close()
         client = left_open.unwrapped.sim.client
@@ -516,7 +516,7 @@ def test_sim_frequency_over_the_cap_is_refused_by_the_env_itself() -> None:
 
     limit = cap("sim_frequency")
     with pytest.raises(ValueError, match="over the cap"):
-        gym.make("SGCPoint-v0", sim_frequency=limit - limit % 60 + 60)
-    env = gym.make("SGCPoint-v0", sim_frequency=limit - limit % 60)
+        gym.make("SGCPoint-v1", sim_frequency=limit - limit % 60 + 60)
+    env = gym.make("SGCPoint-v1", sim_frequency=limit - limit % 60)
     assert env.unwrapped.substeps == (limit - limit % 60) // 60
     env.close()

@@ -1,4 +1,4 @@
-"""SGCPointGoal-v0's goals carry their time: HER's relabelled goal is "this point at this tick".
+"""SGCPointGoal-v1's goals carry their time: HER's relabelled goal is "this point at this tick".
 
 The desired goal holds the goal's time and the achieved goal the current time, so hindsight
 relabelling with a later achieved goal asks for that point *at that tick*: being at the point
@@ -20,7 +20,7 @@ def her_batch():
     from stable_baselines3 import HerReplayBuffer
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    vec = DummyVecEnv([lambda: gym.make("SGCPointGoal-v0")])
+    vec = DummyVecEnv([lambda: gym.make("SGCPointGoal-v1")])
     vec.seed(3)
     buffer = HerReplayBuffer(
         5_000, vec.observation_space, vec.action_space, env=vec, n_sampled_goal=4,
@@ -82,7 +82,7 @@ def test_a_relabelled_success_is_the_point_on_its_tick(her_batch) -> None:
 
 
 def test_the_env_reward_is_compute_reward_of_the_step() -> None:
-    env = gym.make("SGCPointGoal-v0")
+    env = gym.make("SGCPointGoal-v1")
     obs, _ = env.reset(seed=5)
     for _ in range(30):
         nxt, reward, terminated, truncated, info = env.step(np.zeros(3, np.float32))

@@ -84,7 +84,7 @@ def test_rejected_construction_leaves_no_client():
         with pytest.raises(ValueError, match="3 courses"):
             SGCEnv(somersault(2.0 / 60.0))
         with pytest.raises(ValueError, match="sim_frequency"):
-            gym.make("SGCRod-v0", sim_frequency=250)
+            gym.make("SGCRod-v1", sim_frequency=250)
     assert connected_clients() == before
 
 
@@ -99,7 +99,7 @@ def test_failure_after_the_client_exists_leaks_nothing(monkeypatch):
     before = connected_clients()
     for _ in range(5):
         with pytest.raises(RuntimeError, match="no body today"):
-            gym.make("SGCRod-v0")
+            gym.make("SGCRod-v1")
     assert connected_clients() == before  # closed at once, not left to the garbage collector
 
 
@@ -119,7 +119,7 @@ def test_300_unclosed_envs_keep_memory_flat():
     clients = connected_clients()
     start = _rss_mb()
     for _ in range(300):
-        env = gym.make("SGCRod-v0")
+        env = gym.make("SGCRod-v1")
         env.reset(seed=0)
         env.step(env.action_space.sample())
         del env  # never closed: the finaliser must free the PyBullet client

@@ -21,8 +21,8 @@ from sgc_env.envs.rewards import REWARD_MODES
 
 HELD_OUT = 20000  # reset seeds of the ranking; training and the leaderboards use others
 RANKED = ("expert", "minimum-jerk", "dynamic-constraints", "random")
-FIXED_SCENES = ("SGCIntercept-v0", "SGCThreeRods-v1")
-COSTLY_SCENES = (*FIXED_SCENES, "SGCThreeRodsRandom-v2")
+FIXED_SCENES = ("SGCIntercept-v1", "SGCThreeRods-v2")
+COSTLY_SCENES = (*FIXED_SCENES, "SGCThreeRodsRandom-v3")
 """Two seeds in the default run, 20 in the slow test: the fixed scenes replay one episode for
 the deterministic controllers, and the random three-rod scene costs minutes for 20 seeds
 (80 three-rod episodes, each reset planning the rods: 370 s on the loaded 2-core machine)."""
@@ -132,7 +132,7 @@ class EarlyHold:
         return 1.0 if arrive <= dt else dt / arrive
 
 
-@pytest.mark.parametrize("env_id", ["SGCPoint-v0", "SGCRod-v0"])
+@pytest.mark.parametrize("env_id", ["SGCPoint-v1", "SGCRod-v1"])
 def test_reaching_each_goal_early_and_holding_it_earns_less_than_the_expert(env_id):
     env = gym.make(env_id)
     expert = make_policy("expert", env)
@@ -159,7 +159,7 @@ def test_reaching_each_goal_early_and_holding_it_earns_less_than_the_expert(env_
 
 def test_the_distance_reward_pays_for_arriving_early():
     """Why the default changed: under the old reward the early policy beats the expert."""
-    env = gym.make("SGCPoint-v0", reward="distance")
+    env = gym.make("SGCPoint-v1", reward="distance")
     expert_return, _ = episode_return(env, make_policy("expert", env), HELD_OUT)
     early_return, _ = episode_return(env, EarlyHold(env), HELD_OUT)
     env.close()
@@ -169,7 +169,7 @@ def test_the_distance_reward_pays_for_arriving_early():
 @pytest.mark.parametrize("mode", ["schedule", "sparse"])
 def test_failing_never_pays(mode, make_env):
     """Leaving the workspace at once earns less than any full episode can."""
-    env = make_env("SGCRod-v0", reward=mode)
+    env = make_env("SGCRod-v1", reward=mode)
     env.reset(seed=HELD_OUT)
     base = env.unwrapped
     steps = base.max_steps
@@ -187,7 +187,7 @@ def test_failing_never_pays(mode, make_env):
 
 
 def test_expert_earns_the_goal_bonuses_and_almost_no_cost(make_env):
-    env = make_env("SGCRod-v0", reward="sparse")
+    env = make_env("SGCRod-v1", reward="sparse")
     total, infos = episode_return(env, make_policy("expert", env), HELD_OUT)
     goals = sum(len(info.get("goal_reached", [])) for info in infos)
     env.close()
@@ -199,7 +199,7 @@ def test_expert_earns_the_goal_bonuses_and_almost_no_cost(make_env):
 def test_modes_share_the_physics_and_differ_in_reward(make_env):
     rewards, observations = {}, []
     for mode in REWARD_MODES:
-        env = make_env("SGCPoint-v0", reward=mode)
+        env = make_env("SGCPoint-v1", reward=mode)
         env.reset(seed=3)
         out = [env.step(np.full(3, 0.1)) for _ in range(20)]
         env.close()
@@ -211,4 +211,4 @@ def test_modes_share_the_physics_and_differ_in_reward(make_env):
 
 def test_unknown_reward_mode_names_the_choices(make_env):
     with pytest.raises(ValueError, match=r"reward: unknown mode 'dense'.*schedule.*distance"):
-        make_env("SGCPoint-v0", reward="dense")
+        make_env("SGCPoint-v1", reward="dense")

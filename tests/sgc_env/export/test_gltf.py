@@ -82,7 +82,7 @@ def test_every_goal_tick_of_every_id_reads_back_as_the_env_put_it(env_id, tmp_pa
 
 
 def test_the_root_turns_z_up_into_y_up(tmp_path):
-    env, infos = _flight("SGCPoint-v0")
+    env, infos = _flight("SGCPoint-v1")
     glb = read_glb(write_glb(tmp_path / "f.glb", env.unwrapped.scenario, [motion_of("a", infos)]))
     up = glb.world_of_parent(glb.node_index("a/" + env.unwrapped.scenario.bodies[0].name))
     np.testing.assert_allclose(up.apply([0.0, 0.0, 1.0]), [0.0, 1.0, 0.0], atol=1e-15)
@@ -90,7 +90,7 @@ def test_the_root_turns_z_up_into_y_up(tmp_path):
 
 
 def test_two_motions_are_two_named_animations_of_their_own_groups(tmp_path):
-    env, infos = _flight("SGCThreeRods-v1")
+    env, infos = _flight("SGCThreeRods-v2")
     scenario = env.unwrapped.scenario
     first = motion_of("expert", infos)
     second = dataclasses.replace(first, label="learner", positions=first.positions + 1.0)
@@ -109,7 +109,7 @@ def test_two_motions_are_two_named_animations_of_their_own_groups(tmp_path):
 
 
 def test_colours_are_the_renderers_in_linear_space(tmp_path):
-    env, infos = _flight("SGCThreeRods-v1")
+    env, infos = _flight("SGCThreeRods-v2")
     scenario = env.unwrapped.scenario
     glb = read_glb(write_glb(tmp_path / "c.glb", scenario, [motion_of("a", infos)]))
     for body in scenario.bodies:
@@ -121,7 +121,7 @@ def test_colours_are_the_renderers_in_linear_space(tmp_path):
 
 
 def test_rods_are_drawn_as_thick_as_asked_never_thinner(tmp_path):
-    env, infos = _flight("SGCRod-v0")
+    env, infos = _flight("SGCRod-v1")
     scenario = env.unwrapped.scenario
     radius = scenario.bodies[0].size[1]
     for asked, expected in ((None, radius), (radius / 2, radius), (0.075, 0.075)):
@@ -167,7 +167,7 @@ def _motion(bodies: int = 1, ticks: int = 3) -> Motion:
     ],
 )
 def test_a_bad_motion_is_refused_naming_its_field(change, message):
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     env.reset(seed=0)
     scenario = env.unwrapped.scenario
     motion = dataclasses.replace(_motion(), **change)
@@ -176,7 +176,7 @@ def test_a_bad_motion_is_refused_naming_its_field(change, message):
 
 
 def test_no_motion_twice_a_label_or_a_bad_radius_is_refused():
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     env.reset(seed=0)
     scenario = env.unwrapped.scenario
     with pytest.raises(ValueError, match="at least one motion"):
@@ -192,7 +192,7 @@ def test_no_motion_twice_a_label_or_a_bad_radius_is_refused():
 
 
 def test_the_size_cap_is_checked_before_any_work(monkeypatch):
-    env = gym.make("SGCPoint-v0")
+    env = gym.make("SGCPoint-v1")
     env.reset(seed=0)
     monkeypatch.setattr(gltf, "MAX_GLB_BYTES", 1 << 20)
 
@@ -205,9 +205,9 @@ def test_the_size_cap_is_checked_before_any_work(monkeypatch):
 
 
 def test_same_flight_same_bytes():
-    env, infos = _flight("SGCRod-v0")
+    env, infos = _flight("SGCRod-v1")
     one = glb_bytes(env.unwrapped.scenario, [motion_of("a", infos)])
-    env2, infos2 = _flight("SGCRod-v0")
+    env2, infos2 = _flight("SGCRod-v1")
     assert one == glb_bytes(env2.unwrapped.scenario, [motion_of("a", infos2)])
 
 

@@ -91,7 +91,7 @@ def test_rule_names_are_checked_everywhere():
         course_end_velocity(d, nxt, 1.0, 1.0, rule="spline")
     with pytest.raises(ValueError, match="end_rule"):
         PlanOptions(end_rule="spline")
-    env = gym.make("SGCRod-v0")
+    env = gym.make("SGCRod-v1")
     with pytest.raises(ValueError, match="end_rule"):
         SGCExpert(env, end_rule="spline")
     env.close()
@@ -126,7 +126,7 @@ def test_scenario_option_reaches_the_expert():
         "end_velocity_rule": "paper",
     }  # fmt: skip
     assert scenario_from_dict(data).end_velocity_rule == "paper"
-    env = gym.make("SGCThreeRods-v1")
+    env = gym.make("SGCThreeRods-v2")
     assert SGCExpert(env).model.end_rule == "tangent"
     expert = make_policy("expert-paper", env)
     assert isinstance(expert, EpisodeExpert) and expert.end_rule == "paper"
@@ -136,7 +136,7 @@ def test_scenario_option_reaches_the_expert():
 
 def test_on_the_three_rods_tangent_beats_the_paper_and_stays_exact():
     """The issue's acceptance on the demo scene, through the harness."""
-    cards = {p: evaluate(p, "SGCThreeRods-v1", 1, 0).summary for p in ("expert", "expert-paper")}
+    cards = {p: evaluate(p, "SGCThreeRods-v2", 1, 0).summary for p in ("expert", "expert-paper")}
     for card in cards.values():
         assert card["success_rate"] == 1.0
         assert card["position_error_max"] <= GOAL_TOLERANCE
@@ -155,7 +155,7 @@ def test_on_the_three_rods_tangent_beats_the_paper_and_stays_exact():
 @pytest.mark.slow
 def test_on_50_held_out_rod_seeds_tangent_beats_the_paper_and_stays_exact():
     cards = {
-        p: evaluate(p, "SGCRod-v0", 50, 10000).summary
+        p: evaluate(p, "SGCRod-v1", 50, 10000).summary
         for p in ("expert", "expert-paper", "minimum-jerk")
     }
     for name in ("expert", "expert-paper"):
@@ -169,4 +169,4 @@ def test_on_50_held_out_rod_seeds_tangent_beats_the_paper_and_stays_exact():
 
 
 def test_sgc_env_registers_what_the_policies_use():
-    assert "SGCThreeRods-v1" in sgc_env.ENV_IDS
+    assert "SGCThreeRods-v2" in sgc_env.ENV_IDS

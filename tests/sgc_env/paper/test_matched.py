@@ -87,7 +87,7 @@ def test_substep_lag_is_the_held_force_velocity_lag():
 
 
 def test_expert_matched_meets_every_goal_and_needs_its_scenario():
-    env = gym.make("SGCRod-v0")
+    env = gym.make("SGCRod-v1")
     with pytest.raises(ValueError, match="end_rule must be one of"):
         SGCExpert(env, end_rule="spline")
     with pytest.raises(ValueError, match="needs the env or the episode's scenario"):
@@ -98,7 +98,7 @@ def test_expert_matched_meets_every_goal_and_needs_its_scenario():
     assert course_key([*track.course_start[0], track.durations[0], *track.next_start[0],
                        track.next_duration[0]]) in table  # fmt: skip
     env.close()
-    result = evaluate("expert-matched", "SGCRod-v0", 2, 3, keep_infos=0)
+    result = evaluate("expert-matched", "SGCRod-v1", 2, 3, keep_infos=0)
     for record in result.episodes:
         card = record.card["bodies"][0]
         assert card["goals_met"] == card["n_goals"]
@@ -112,7 +112,7 @@ def test_episode_expert_reads_each_sub_envs_scenario():
     courses up in its own table, so no course falls back to the tangent rule."""
     from baselines.policies import make_policy
 
-    envs = gym.vector.SyncVectorEnv([lambda: gym.make("SGCRod-v0") for _ in range(2)])
+    envs = gym.vector.SyncVectorEnv([lambda: gym.make("SGCRod-v1") for _ in range(2)])
     obs, _ = envs.reset(seed=[5, 6])
     policy = make_policy("expert-matched", envs)
     policy.predict(obs, episode_start=np.array([True, True]))

@@ -10,7 +10,7 @@ import sgc_env  # noqa: F401  (registers the ids)
 from baselines.controllers.expert import SGCExpert
 from sgc_env.envs import SGCEnv
 
-WATCHED = ("SGCRod-v0", "SGCThreeRods-v1", "SGCIntercept-v0")
+WATCHED = ("SGCRod-v1", "SGCThreeRods-v2", "SGCIntercept-v1")
 
 
 def _largest_colour_share(frame: np.ndarray) -> float:
@@ -64,7 +64,7 @@ def test_every_body_stays_in_frame_of_the_fixed_camera(env_id):
 
 
 def test_tracking_camera_follows_the_bodies():
-    frames = _expert_positions("SGCThreeRods-v1", camera="tracking")
+    frames = _expert_positions("SGCThreeRods-v2", camera="tracking")
     looks = {view.orbit[0] for view, _ in frames}
     assert len(looks) > len(frames) // 2  # it moves
     for view, positions in frames:
@@ -73,7 +73,7 @@ def test_tracking_camera_follows_the_bodies():
 
 
 def test_width_and_height_set_the_frame():
-    env = gym.make("SGCPoint-v0", render_mode="rgb_array", width=96, height=64)
+    env = gym.make("SGCPoint-v1", render_mode="rgb_array", width=96, height=64)
     env.reset(seed=0)
     assert env.render().shape == (64, 96, 3)
     env.step(env.action_space.sample())
@@ -137,7 +137,7 @@ def test_rendering_changes_neither_physics_nor_saved_states():
 def test_same_seed_same_frames():
     frames = []
     for _ in range(2):
-        env = gym.make("SGCIntercept-v0", render_mode="rgb_array", width=64, height=48)
+        env = gym.make("SGCIntercept-v1", render_mode="rgb_array", width=64, height=48)
         env.reset(seed=3)
         for _ in range(5):
             env.step(np.full(3, 0.2, np.float32))
@@ -155,7 +155,7 @@ def test_human_mode_without_a_display_is_a_clear_error(monkeypatch):
 def test_record_video_writes_an_expert_episode(tmp_path):
     from gymnasium.wrappers import RecordVideo
 
-    env = gym.make("SGCIntercept-v0", render_mode="rgb_array", width=160, height=120)
+    env = gym.make("SGCIntercept-v1", render_mode="rgb_array", width=160, height=120)
     env = RecordVideo(
         env, str(tmp_path / "videos"), episode_trigger=lambda _: True, disable_logger=True
     )
@@ -176,7 +176,7 @@ def test_sb3_video_recorder_as_rl_zoo3_uses_it(tmp_path):
     vector env in SB3's ``VecVideoRecorder``: the same path, without a zoo model folder."""
     from stable_baselines3.common.vec_env import DummyVecEnv, VecVideoRecorder
 
-    venv = DummyVecEnv([lambda: gym.make("SGCIntercept-v0", render_mode="rgb_array", width=160,
+    venv = DummyVecEnv([lambda: gym.make("SGCIntercept-v1", render_mode="rgb_array", width=160,
                                          height=120)])  # fmt: skip
     venv = VecVideoRecorder(venv, str(tmp_path), record_video_trigger=lambda step: step == 0,
                             video_length=30, name_prefix="zoo")  # fmt: skip
@@ -195,7 +195,7 @@ def test_env_checkers_pass_with_rendering():
     from gymnasium.utils.env_checker import check_env
     from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-    env = gym.make("SGCRod-v0", render_mode="rgb_array", width=64, height=48)
+    env = gym.make("SGCRod-v1", render_mode="rgb_array", width=64, height=48)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, skip_render_check=False)

@@ -1,4 +1,4 @@
-"""The paper's scenes that vary: SGCInterceptRandom-v0 and SGCThreeRodsRandom-v2.
+"""The paper's scenes that vary: SGCInterceptRandom-v1 and SGCThreeRodsRandom-v3.
 
 Every reset draws a new scene from the env's own ``np_random``; the expert meets every goal
 exactly on every draw without needing an action beyond the limits; the spaces never change.
@@ -23,8 +23,8 @@ from sgc_env.scenes.three_rods import ROD_SPECS, build_three_rods
 
 EXACT = 1e-9
 DEMAND_SHARE = 0.8  # what both families allow the plan's bounds to use of each limit
-RANDOM_IDS = ("SGCInterceptRandom-v0", "SGCThreeRodsRandom-v2")
-FIXED_OF = {"SGCInterceptRandom-v0": "SGCIntercept-v0", "SGCThreeRodsRandom-v2": "SGCThreeRods-v1"}
+RANDOM_IDS = ("SGCInterceptRandom-v1", "SGCThreeRodsRandom-v3")
+FIXED_OF = {"SGCInterceptRandom-v1": "SGCIntercept-v1", "SGCThreeRodsRandom-v3": "SGCThreeRods-v2"}
 
 
 def _expert_run(env, expert, seed: int) -> tuple[np.ndarray, list[float], bool]:
@@ -71,7 +71,7 @@ def _check_expert(env_id: str, seeds, *, against_plan: bool = False) -> float:
 
 
 @pytest.mark.parametrize(
-    ("env_id", "seeds"), [("SGCInterceptRandom-v0", range(5)), ("SGCThreeRodsRandom-v2", [0])]
+    ("env_id", "seeds"), [("SGCInterceptRandom-v1", range(5)), ("SGCThreeRodsRandom-v3", [0])]
 )
 def test_expert_is_exact_within_the_limits_on_a_few_draws(env_id, seeds):
     _check_expert(env_id, [2000 + s for s in seeds], against_plan=True)
