@@ -1,14 +1,16 @@
 """Paste a ``sgc benchmark`` leaderboard into a markdown document, between markers.
 
-docs/results.md carries the leaderboards that ``sgc benchmark`` wrote, verbatim
-(its title dropped and its env headings demoted to ``###``), between the lines
-``<!-- leaderboard:begin -->`` and ``<!-- leaderboard:end -->``, so a rerun of the benchmark
-updates them with one command::
+docs/results.md carries the leaderboards that ``sgc benchmark`` wrote, verbatim (its title
+dropped and its env headings demoted to ``###``), each between the lines
+``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` of its marker, so a rerun of the benchmark
+updates it with one command::
 
-    python scripts/paste_leaderboard.py runs/benchmark/v2/leaderboard.md docs/results.md
+    python scripts/paste_leaderboard.py --marker stock-leaderboard \
+        runs/benchmark/budget/leaderboard.md docs/results.md
 
-``--marker NAME`` pastes between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` instead, so
-one document can carry several leaderboards (the equal wall-clock one is ``budget-leaderboard``).
+docs/results.md has two: ``stock-leaderboard`` (the equal wall-clock rows,
+``scripts/run_budget_rows.sh``) and ``threerod-leaderboard`` (``scripts/run_threerod_rows.sh``).
+Without ``--marker`` the pair is ``leaderboard``.
 """
 
 from __future__ import annotations

@@ -11,7 +11,8 @@ that produced it written in the block, so a table is never typed by hand::
 output the command wrote last is pasted. Every markdown file of the README and ``docs/``
 that holds the block's markers is updated. The leaderboards of ``sgc benchmark`` are pasted
 by ``scripts/paste_leaderboard.py`` (their runs take hours); ``leaderboard-summary`` condenses
-the pasted equal wall-clock leaderboard of ``docs/results.md`` into the README's table.
+the pasted equal wall-clock leaderboard of the stock tools in ``docs/results.md`` (the
+``stock-leaderboard`` block) into the README's table.
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ RESULTS = {
 }
 SUMMARY = "leaderboard-summary"
 SUMMARY_SOURCE = "docs/results.md"
-SUMMARY_MARKER = "budget-leaderboard"
+SUMMARY_MARKER = "stock-leaderboard"
 
 
 def markers(name: str) -> tuple[str, str]:
@@ -142,9 +143,11 @@ def leaderboard_summary(leaderboard: str) -> str:
 
 
 def summary_block(results_doc: str) -> str:
-    """The README's summary of the equal wall-clock leaderboard in ``docs/results.md``."""
+    """The README's summary of the stock tools' equal wall-clock leaderboard in
+    ``docs/results.md``."""
     board = block(results_doc, SUMMARY_MARKER, SUMMARY_SOURCE)
-    return (f"Condensed from the equal wall-clock leaderboard in [results]({SUMMARY_SOURCE}) "
+    return (f"Condensed from the stock tools' equal wall-clock leaderboard in "
+            f"[results]({SUMMARY_SOURCE}#at-equal-wall-clock-the-stock-files-under-the-budgets) "
             f"by `.venv/bin/python scripts/paste_results.py {SUMMARY}`:\n\n"
             f"{leaderboard_summary(board)}")  # fmt: skip
 

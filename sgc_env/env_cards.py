@@ -9,17 +9,16 @@ writes.
 
 **Versions.** Any change to observations, rewards or dynamics bumps the id's version, as
 Gymnasium does: add a :class:`Version` at the end of the card's ``versions`` (one line) and
-register the id under its new name. Every registered version of a name gets a page of its own
-(its spaces, rewards and arguments read from that version) with the card's whole version
-history; ``tests/sgc_env/test_env_cards.py`` checks that every registered id is a version on
-its card and that each card's latest version is registered. The learner's view table is read
-from :mod:`sgc_env.envs.learner_view`'s docstring, its one home.
+register the id under its new name. One version of each name is registered, the card's latest;
+its page carries the card's whole version history (the earlier versions are named by their
+version only: Gymnasium answers them with ``DeprecatedEnv``). ``tests/sgc_env/test_env_cards.py``
+checks that the registered ids are exactly the cards' latest versions. The learner's view table
+is read from :mod:`sgc_env.envs.learner_view`'s docstring, its one home.
 """
 
 from __future__ import annotations
 
 import argparse
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,15 +63,15 @@ class EnvCard:
 
     @property
     def registered_ids(self) -> list[str]:
-        """The ids of the versions Gymnasium has registered, oldest first (one page each)."""
+        """The ids of the versions Gymnasium has registered, oldest first (one page each):
+        the latest version alone in this release."""
         ids = [f"{self.name}-{v.version}" for v in self.versions]
         return [env_id for env_id in ids if env_id in gym.registry]
 
     @property
     def gif_id(self) -> str:
-        """The id whose expert GIF the card shows: ``gif_of``, else the oldest registered
-        version (every version of a name has the same scenes and physics)."""
-        return self.gif_of or self.registered_ids[0]
+        """The id whose expert GIF the card shows: ``gif_of``, else the card's own id."""
+        return self.gif_of or self.env_id
 
 
 _FIRST = "first release (sgc 0.1.0)."
@@ -89,22 +88,20 @@ _COURSE_BOUND = (
 )
 
 
-def _learner_version(old: str, goal: bool = False) -> str:
-    """The version entry of a name's learner's version; ``old`` the version before it."""
-    reward = ("the reward stays the sparse goal reward" if goal else "`tracking` is the "
-              "default reward (see Rewards: the same on-schedule error as `schedule`, paid in a "
-              "form a learner can climb)")  # fmt: skip
-    kwargs = 'observation="planner"' + ("" if goal else ', reward="schedule"')
-    same = f"`gym.make(id, {kwargs})` steps as `{old}`"
+def _learner_version(goal: bool = False) -> str:
+    """The version entry of a name's learner's version (sgc 1.0.0), the one registered."""
+    reward = ("the reward stays the sparse goal reward" if goal else "the reward is `tracking` "
+              "(see Rewards) in place of the earlier `schedule`")  # fmt: skip
     return (
-        "the learner's view is the default observation (`observation=\"learner\"`, see "
-        f"Observation Space: bounded entries of order 1 that say what the reward measures) and "
-        f"{reward}. Scenes, dynamics, actions and episode lengths are unchanged: {same}, bit "
-        f"for bit. `{old}` keeps the planner's view and its reward: the benchmark's "
-        "leaderboards, the shipped models and the scorecard use it. The exact expert reads the "
-        "planner's view; on this version it reads `env.unwrapped.planner_observation()`, the "
-        "planner's view of the same state (`SGCExpert(env)` does so itself), so "
-        "demonstrations, BC and DAgger store and train on the learner's view."
+        "the learner's view is the observation (`observation=\"learner\"`, see Observation "
+        f"Space: bounded entries of order 1 that say what the reward measures) and {reward}; "
+        "scenes, dynamics, actions and episode lengths are unchanged (sgc 0.5.0). "
+        "`observation=\"planner\"` gives the earlier versions' observation, the privileged "
+        "view the exact expert reads; on this id `SGCExpert(env)` reads it itself "
+        "(`env.unwrapped.planner_observation()`), so demonstrations, BC and DAgger store and "
+        "train on the learner's view. Since sgc 1.0.0 the earlier versions are no longer "
+        "registered: `gym.make` answers them with Gymnasium's `DeprecatedEnv`, naming this id "
+        "([migrating to 1.0](../changelog.md))."
     )
 
 
@@ -122,7 +119,7 @@ CARDS: tuple[EnvCard, ...] = (
         "The bird at rest at (0, 0, 2) m; the fish at (2, -0.5, 0.5) m, swimming through "
         "(1.5, 0, 0.6) m at 1 s and on towards (1, 1, 0.5) m. No noise: every reset is the "
         "same state.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCIntercept-v1"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version())),
     ),
     EnvCard(
         "SGCInterceptRandom",
@@ -130,7 +127,7 @@ CARDS: tuple[EnvCard, ...] = (
         "start drawn per reset.",
         _RANDOM_START + "the bird within 0.5 m of (0, 0, 2) at up to 1.5 m/s, the fish within "
         "0.6 m of (2, -0.5, 0.5) swimming two straight legs at 0.3-1.5 m/s.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCInterceptRandom-v1"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version())),
     ),
     EnvCard(
         "SGCPoint",
@@ -138,7 +135,7 @@ CARDS: tuple[EnvCard, ...] = (
         "its goal time, and move smoothly through them (Liu, Ko & Chang 1993, point goals).",
         _RANDOM_START + "the sphere at rest at (0, 0, 1) m, 3 goals with course lengths, "
         "speeds, turn angles and time-critical shares drawn from the `point` preset.",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPoint-v1"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version())),
     ),
     EnvCard(
         "SGCPointGoal",
@@ -146,7 +143,7 @@ CARDS: tuple[EnvCard, ...] = (
         "`HerReplayBuffer`): a Dict observation and a sparse reward computed by "
         "`compute_reward`.",
         "As `SGCPoint-v1` (the same draws for the same seed).",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCPointGoal-v1", goal=True))),
+        (Version("v0", _FIRST), Version("v1", _learner_version(goal=True))),
         gif_of="SGCPoint-v1",
     ),
     EnvCard(
@@ -156,7 +153,7 @@ CARDS: tuple[EnvCard, ...] = (
         "torques.",
         _RANDOM_START + "the rod at rest at (0, 0, 1) m, upright, 3 goals drawn from the "
         "`rod` preset (relative rotations on).",
-        (Version("v0", _FIRST), Version("v1", _learner_version("SGCRod-v1"))),
+        (Version("v0", _FIRST), Version("v1", _learner_version())),
     ),
     EnvCard(
         "SGCThreeRods",
@@ -166,7 +163,7 @@ CARDS: tuple[EnvCard, ...] = (
         "The three rods at the scene's launch poses, x about -9.2 m, flying at 2-2.5 m/s "
         "towards the board at x = 8 m; the balls at their start points. No noise.",
         (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT),
-         Version("v2", _learner_version("SGCThreeRods-v2"))),
+         Version("v2", _learner_version())),
     ),
     EnvCard(
         "SGCThreeRodsRandom",
@@ -176,7 +173,7 @@ CARDS: tuple[EnvCard, ...] = (
         "and only draws whose bound of the plan's force and torque stays within 80 % of each "
         "limit.",
         (Version("v0", _FIRST), Version("v1", _SMOOTH_SPLIT), Version("v2", _COURSE_BOUND),
-         Version("v3", _learner_version("SGCThreeRodsRandom-v3"))),
+         Version("v3", _learner_version())),
     ),
 )
 
@@ -197,26 +194,19 @@ MEANING = {
     "position_flags": "(has a position track, current goal is the last)",
 }
 REWARDS = {
-    "schedule": "`-mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2) + "
-    "bonus`, with `D_sched = D_i(0) time_left / T_i` the course travelled on schedule (the "
-    "paper's behaviour equation in its neutral member); a failure is charged the worst "
-    "per-step reward for every step left.",
     "tracking": "`mean_b sum_tracks 1 / (1 + |D - D_sched| / L) + 0.01 (1 - mean(a^2)) + "
-    "bonus`, no failure charge: the same on-schedule error as `schedule`, paid in a form a "
-    "learner can climb. `1 / (1 + x)` falls at every distance, where `min(x, 1)` is flat beyond "
-    "a course length (where an untrained body spends its first episodes); a step alive pays "
-    "between 0 and the number of tracks, so leaving the workspace loses the rest of the "
-    "episode's pay instead of one lump charge a value function has to predict. Undiscounted it "
-    "ranks policies that finish their episodes as `schedule` does, up to a constant per "
-    "scenario.",
-    "distance": "`-mean_b(|D| / L + |phi| / A) - 0.01 mean(a^2) + bonus` (pays for arriving "
-    "early and hovering; kept for comparison).",
-    "sparse": "`-0.01 mean(a^2) + bonus`; a failure is charged 0.01 per step left.",
+    "bonus`, with `D_sched = D_i(0) time_left / T_i` the course travelled on schedule (the "
+    "paper's behaviour equation in its neutral member), no failure charge. `1 / (1 + x)` falls "
+    "at every distance, so a body far off its schedule (where an untrained one spends its "
+    "first episodes) still sees a slope; a step alive pays between 0 and the number of "
+    "tracks, so leaving the workspace loses the rest of the episode's pay instead of one lump "
+    "charge a value function has to predict.",
 }
 REWARD_TERMS = (
-    "`L = max(|D_i(0)|, 0.1 m)`, `A = max(|phi_i(0)|, 0.5 rad)`, `bonus` = per goal met this "
-    "tick `exp(-|D| / 0.01 m)` (+ `exp(-|phi| / 0.02 rad)`); pick one with "
-    '`gym.make(id, reward="...")` ([Reward modes](../environments.md#reward-modes)).'
+    "`L = max(|D_i(0)|, 0.1 m)` (for orientation `max(|phi_i(0)|, 0.5 rad)`), `bonus` = per "
+    "goal met this tick `exp(-|D| / 0.01 m)` (+ `exp(-|phi| / 0.02 rad)`); "
+    "`gym.make(id, reward=...)` takes a `RewardMode` of your own instead "
+    "([the reward](../environments.md#the-reward))."
 )
 GOAL_REWARD = (
     "Sparse, from `compute_reward(achieved_goal, desired_goal, info)` (vectorised, the call "
@@ -231,8 +221,10 @@ EPISODE_END = (
     "`info['spin_clamped']`, not terminal."
 )
 ARGUMENTS = (
-    "`gym.make(\"{env_id}\", ...)`: `reward` ({rewards}), `observation` (`\"planner\"`, "
-    "`\"learner\"`), `control_frequency` (Hz), `sim_frequency` (240 Hz, a multiple of it), "
+    "`gym.make(\"{env_id}\", ...)`: `reward` ({rewards}, or a `RewardMode` instance of your "
+    "own), `observation` (`\"learner\"`; `\"planner\"`, the privileged view: the planner's "
+    "state as the observation, which the evaluation harness uses to fly the analytic "
+    "controllers), `control_frequency` (Hz), `sim_frequency` (240 Hz, a multiple of it), "
     "`time_grid` (`\"reject\"`, `\"snap\"`), `scenario` (a Scenario, built-in name or YAML "
     "path, instead of the registered one), `render_mode` (`\"rgb_array\"`; `\"human\"` opens "
     "PyBullet's GUI where a display exists), `width`/`height` (frame size, 640x480), `camera` "
@@ -409,9 +401,7 @@ def card_markdown(card: EnvCard, env_id: str | None = None) -> str:
     """The card of one registered version of ``card`` (None: the newest; markdown, a ``###``
     section)."""
     env_id = env_id or card.env_id
-    with warnings.catch_warnings():  # Gymnasium's "out of date" notice: older pages on purpose
-        warnings.simplefilter("ignore", DeprecationWarning)
-        env = gym.make(env_id)
+    env = gym.make(env_id)
     sections: list[tuple[str, Sequence[str]]] = [
         ("Description", [card.description, "", _gif(card, env_id)]),
         ("Action Space", _action(env)),
@@ -439,24 +429,22 @@ def page_markdown(card: EnvCard, env_id: str | None = None) -> str:
 
 def index_markdown() -> str:
     """The folder's index: the ids in ladder order, one line each."""
-    rows = ["| env | the benchmark's version: planner's view | the newest: learner's view |",
-            "|---|---|---|"]
+    rows = ["| env | id | description |", "|---|---|---|"]
     for card in CARDS:
-        *older, newest = card.registered_ids
-        rows.append(f"| {card.name} | {', '.join(f'[{i}]({i}.md)' for i in older)} | "
-                    f"[{newest}]({newest}.md) |")  # fmt: skip
+        for env_id in card.registered_ids:
+            first = card.description.split(". ")[0].rstrip(".")
+            rows.append(f"| {card.name} | [{env_id}]({env_id}.md) | {first}. |")
     ids = [env_id for card in CARDS for env_id in card.registered_ids]
     lines = [GENERATED, "", "# Environment cards", "",
              "One card per registered id, in the sections Gymnasium's cards use; spaces, the "
              "observation layout, limits, episode lengths and registered arguments are read "
              "from the envs themselves. The ladder and what each rung tests: "
              "[environments](../environments.md).", "",
-             "Every env has two registered versions with the same scenes and physics. The "
-             "benchmark's version observes the planner's view and pays the `schedule` reward "
-             "(the leaderboards, the shipped models and the scorecard use it); the newest "
-             "observes the learner's view and pays the `tracking` reward (the goal id: its own "
-             "sparse reward). Each card's version history says what changed.", "",
-             *rows, "", "```{toctree}", ":maxdepth: 1", "", *ids, "```", ""]  # fmt: skip
+             "Every id observes the learner's view and pays the `tracking` reward (the goal "
+             "id: its own sparse reward); `observation=\"planner\"` gives the privileged view "
+             "the analytic controllers read. Each card's version history says what changed; "
+             "the earlier versions are no longer registered ([migrating to 1.0](../changelog.md)).",
+             "", *rows, "", "```{toctree}", ":maxdepth: 1", "", *ids, "```", ""]  # fmt: skip
     return "\n".join(lines)
 
 

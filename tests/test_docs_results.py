@@ -19,6 +19,10 @@ from tests.script_module import load_script
 ROOT = Path(__file__).resolve().parents[1]
 
 
+LEADERBOARDS = ("threerod-leaderboard", "stock-leaderboard")
+"""The blocks scripts/paste_leaderboard.py writes (``sgc benchmark`` sweeps, hours each)."""
+
+
 def _paste():
     return load_script("paste_results")
 
@@ -47,8 +51,7 @@ def test_every_marker_pair_in_the_docs_is_a_known_table() -> None:
     names = set(paste.RESULTS) | {paste.SUMMARY}
     for doc in paste.documents():
         for name in re.findall(r"<!-- ([\w-]+):begin -->", doc.read_text()):
-            known = name in names or name in ("leaderboard", "budget-leaderboard",
-                                              "threerod-leaderboard", "stock-leaderboard")
+            known = name in names or name in LEADERBOARDS
             assert known, f"{doc.name}: block {name!r} has no command in paste_results.py"
 
 
@@ -73,7 +76,19 @@ def test_readme_summary_is_the_results_leaderboard() -> None:
     ((readme, text),) = _pasted(paste.SUMMARY)
     assert readme.name == "README.md"
     assert text == paste.summary_block((ROOT / paste.SUMMARY_SOURCE).read_text())
-    assert "| `SGCRod-v1` | `ppo-rod300-300s` | no | 10 | 76 | 0.92 [0.84, 0.98] |" in text
+    assert "| `SGCRod-v1` | `zoo-ppo-300s` | no | 10 | 55 | 0.97 [0.90, 1.00] |" in text
+
+
+def test_every_leaderboard_is_in_results_once_with_its_reproduce_line() -> None:
+    """docs/results.md holds each leaderboard block once, each with the command that wrote
+    it; no other document holds one."""
+    results = ROOT / "docs" / "results.md"
+    for name in LEADERBOARDS:
+        body = paste.block(results.read_text(), name, str(results))
+        assert body.startswith("Reproduce: `sgc benchmark --recipes benchmarks/recipes.yml "), name
+        for doc in paste.documents():
+            if doc != results:
+                assert f"<!-- {name}:begin -->" not in doc.read_text(), (doc, name)
 
 
 def test_a_table_needs_its_markers_once() -> None:

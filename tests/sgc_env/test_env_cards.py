@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import gymnasium as gym
@@ -17,15 +18,14 @@ SECTIONS = ("Description", "Action Space", "Observation Space", "Rewards", "Star
 
 
 def test_every_registered_id_is_a_version_on_its_card():
-    """Each card's newest version is a learner's id, its version before it the benchmark's
-    id; no other SGC id is registered."""
+    """Each card's latest version is registered, and it alone: the registered ids are
+    exactly the cards' ids."""
     assert sorted(card.env_id for card in CARDS) == sorted(sgc_env.ENV_IDS)
     registered = [env_id for card in CARDS for env_id in card.registered_ids]
     assert sorted(registered) == sorted(sgc_env.ENV_IDS)
     for card in CARDS:
-        assert card.registered_ids[-1] == card.env_id
-        assert card.registered_ids[-2] in sgc_env.ENV_IDS
-        assert all(gym.spec(i).name == card.name for i in card.registered_ids)
+        assert card.registered_ids == [card.env_id]
+        assert gym.spec(card.env_id).name == card.name
 
 
 def _card(env_id: str) -> str:
@@ -40,7 +40,7 @@ def test_every_card_has_every_section_and_an_existing_gif():
             for section in SECTIONS:
                 assert f"#### {section}\n" in text, (env_id, section)
             assert f"- {env_id.rsplit('-', 1)[1]} (this page): " in text
-            assert "- [v" in text  # the other registered version, linked
+            assert "(no longer registered)" in text  # the earlier versions, named by version
         gif = ROOT / "docs" / gif_path(card.gif_id)
         assert gif.is_file() and gif.stat().st_size < 400_000, gif
 
@@ -52,21 +52,20 @@ def test_cards_read_spaces_from_the_envs():
     assert "`Dict`" in goal and "compute_reward" in goal
 
 
-@pytest.mark.parametrize(("old", "new"), [("SGCRod-v1", "SGCRod-v1"),
-                                          ("SGCThreeRodsRandom-v3", "SGCThreeRodsRandom-v3")])
-def test_the_versions_say_which_view_and_reward_they_have(old: str, new: str):
-    """The benchmark's version: the planner's layout and `schedule` by default; the newest:
-    the learner's table (each entry with its why) and `tracking` by default, explained; both
-    pages tell what changed between them."""
-    before, after = _card(old), _card(new)
-    assert "The planner's view" in before and "`position_deviation`" in before
-    assert "- `schedule` (default)" in before and "- `tracking`: " in before
-    assert "The learner's view" in after and "`position_deviation`" not in after
-    assert "| on-schedule error `D - D_sched` | 0 | 3 |" in after
-    assert "| what the reward charges |" in after and "time feature" in after
-    assert "- `tracking` (default): " in after and "falls at every distance" in after
-    change = f"`{old}` keeps the planner's view and its reward"
-    assert change in before and change in after
+@pytest.mark.parametrize("env_id", ["SGCRod-v1", "SGCThreeRodsRandom-v3"])
+def test_the_cards_say_which_view_and_reward_they_have(env_id: str):
+    """Every id: the learner's table (each entry with its why) and `tracking` by default,
+    explained; the planner's view is named as the privileged one; the version history says
+    the earlier versions are answered with DeprecatedEnv, naming no earlier id."""
+    text = _card(env_id)
+    assert "The learner's view" in text and "`position_deviation`" not in text
+    assert "| on-schedule error `D - D_sched` | 0 | 3 |" in text
+    assert "| what the reward charges |" in text and "time feature" in text
+    assert "- `tracking` (default): " in text and "falls at every distance" in text
+    assert "`\"planner\"`, the privileged view" in text
+    assert "`DeprecatedEnv`" in text
+    name = env_id.rsplit("-", 1)[0]
+    assert [i for i in re.findall(rf"{name}-v\d+", text) if i != env_id] == []
 
 
 def test_the_learner_table_matches_the_views_bounds():

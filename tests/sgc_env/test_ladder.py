@@ -25,5 +25,5 @@ def test_readme_holds_the_generated_short_ladder():
 
 def test_the_ladder_reads_spaces_from_the_envs():
     table = ladder.markdown()
-    assert "| `SGCThreeRodsRandom-v3` | 3 rods | Box (232,) | Box (18,) |" in table
-    assert "| `SGCIntercept-v1` | 1 sphere | Box (78,) | Box (3,) | 2 | fixed |" in table
+    assert "| `SGCThreeRodsRandom-v3` | 3 rods | Box (148,) | Box (18,) |" in table
+    assert "| `SGCIntercept-v1` | 1 sphere | Box (50,) | Box (3,) | 2 | fixed |" in table
