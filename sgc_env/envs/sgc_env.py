@@ -26,7 +26,11 @@ and re-applied on every substep (the torque too: it is fixed at the step's start
 
 ## Observation space
 
-Flat float32 ``Box`` (bounds +-1e5); per-body blocks then ``time``; offsets from
+The learner's view by default (``observation="learner"``, :mod:`sgc_env.envs.learner_view`:
+per body and track the deviations and course terms scaled to their course, bounds +-3).
+``observation="planner"`` observes the planner's state instead, the privileged view the
+evaluation harness gives the analytic controllers (``planner_observation()`` returns it under
+any view): a flat float32 ``Box`` (bounds +-1e5); per-body blocks then ``time``; offsets from
 ``env.unwrapped.layout`` (:class:`~sgc_env.observation.ObservationLayout`):
 
 | field | size | meaning |
@@ -49,31 +53,15 @@ reaches t_i already describes goal i+1.
 
 ## Rewards
 
-``reward=`` (constructor, ``gym.make(id, reward=...)``) picks one of three modes
-(:mod:`sgc_env.envs.rewards` has the code; ``D`` the tracked point's deviation, ``D_i(0)`` and
-``T_i`` the current course's start deviation and duration, ``L = max(|D_i(0)|, 0.1 m)``; the
-same for orientation with ``phi`` and ``A = max(|phi_i(0)|, 0.5 rad)``; ``bonus`` = per goal met
-this tick ``exp(-|D| / 0.01 m)`` (+ ``exp(-|phi| / 0.02 rad)``); means over bodies):
-
-- ``"schedule"`` (default): ``r = -mean_b sum_tracks min(|D - D_sched| / L, 1) - 0.01 mean(a^2)
-  + bonus`` with ``D_sched = D_i(0) time_left / T_i`` (after the last goal ``-v_end
-  time_left``, carrying on at the end velocity). ``D_sched`` is the paper's behaviour equation
-  ``D'' - 2a D' + (a^2 + b^2) D = 0``, ``D(T) = 0``, ``D'(T) = -k D0 / T`` in its neutral member
-  (``k = 1``, ``a = b = 0``): the course travelled on schedule. It depends only on the course
-  and the clock, so the cost vanishes only where the body should be *now*: reaching the nail
-  early and hovering costs ``time_left / T_i`` per step, as does arriving late, and the bonus
-  pays for exactness on the tick; the SGC expert departs from it only by its smooth course
-  starts and earns close to the maximum.
-- ``"distance"`` (the reward before the modes): ``r = -mean_b(|D| / L + |phi| / A) - 0.01
-  mean(a^2) + bonus``. It pays for reaching the nail early and hovering, and ranks the early,
-  inexact dynamic-constraints controller above the expert; kept for comparison.
-- ``"sparse"``: ``r = -0.01 mean(a^2) + bonus``.
-
-A failure (``terminated``) under ``schedule`` and ``sparse`` also charges every step the episode
-had left at the mode's worst per-step reward (``mean_b(tracks) + 0.01``, resp. ``0.01``; the
-per-track cost is capped at 1 for this), so leaving the workspace never ends a negative stream
-early; ``distance`` charges nothing, as before. An unknown mode is a ``ValueError`` naming the
-choices.
+``reward=`` (constructor, ``gym.make(id, reward=...)``) is ``"tracking"``, the one built-in
+mode, or a :class:`~sgc_env.envs.rewards.RewardMode` of the caller's own
+(:mod:`sgc_env.envs.rewards` has the formula and why): ``r = mean_b sum_tracks 1 / (1 + |D -
+D_sched| / L) + 0.01 (1 - mean(a^2)) + bonus`` with ``D_sched = D_i(0) time_left / T_i`` (after
+the last goal ``-v_end time_left``), ``D`` the tracked point's deviation, ``D_i(0)`` and ``T_i``
+the current course's start deviation and duration, ``L = max(|D_i(0)|, 0.1 m)`` (the same for
+orientation with ``phi`` and ``max(|phi_i(0)|, 0.5 rad)``), and ``bonus`` per goal met this tick
+``exp(-|D| / 0.01 m)`` (+ ``exp(-|phi| / 0.02 rad)``); means over bodies. An unknown mode is a
+``ValueError`` naming the choices.
 
 ## Episode end
 
@@ -98,10 +86,8 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``render_mode`` ("human" uses a GUI client, "rgb_array" the look of :mod:`sgc_env.render`),
 ``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
 :class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
-``reward`` (a mode above, ``"tracking"`` or a :class:`~sgc_env.envs.rewards.RewardMode`),
-``observation`` (``"planner"``, the layout above, ``"learner"`` or an
-:class:`~sgc_env.envs.views.ObservationView`; ``planner_observation()`` gives the planner's
-view under any). ``reset(options={"scenario": ...})``
+``reward`` (``"tracking"`` or a :class:`~sgc_env.envs.rewards.RewardMode`), ``observation``
+(``"learner"``, ``"planner"`` or an :class:`~sgc_env.envs.views.ObservationView`). ``reset(options={"scenario": ...})``
 swaps the scenario (same number of bodies and action size; a random-scenario env draws again
 on the next plain reset).
 """
@@ -159,8 +145,8 @@ class SGCEnv(gym.Env):
         camera: str | dict[str, Any] | None = None,
         width: int = 640,
         height: int = 480,
-        reward: str | RewardMode = "schedule",
-        observation: str | ObservationView = "planner",
+        reward: str | RewardMode = "tracking",
+        observation: str | ObservationView = "learner",
         world: SharedWorld | None = None,
     ) -> None:
         self._init_kwargs: dict[str, Any] = {

@@ -26,8 +26,6 @@ def test_record_load_replay_matches(datasets: Path) -> None:
                  "code_permalink": "tests/baselines/agents/test_minari_data.py"}  # fmt: skip
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no out-of-space actions, no Minari advice left
-        # Gymnasium notes that an id has a newer version (the learner's view): not a defect
-        warnings.filterwarnings("ignore", ".*is out of date", DeprecationWarning)
         record_minari("SGCRod-v1", 2, 7, "sgc/rod/expert-v0", **publisher)
     dataset = minari.load_dataset("sgc/rod/expert-v0")
     assert dataset.total_episodes == 2

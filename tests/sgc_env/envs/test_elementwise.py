@@ -11,7 +11,7 @@ import pytest
 from sgc_env.envs.actuation import body_drive
 from sgc_env.envs.failure import body_flags
 from sgc_env.envs.measure import measure
-from sgc_env.envs.rewards import distance_cost, schedule_cost, square_sum
+from sgc_env.envs.rewards import schedule_error, square_sum, tracking_score
 from sgc_env.paper import quaternion
 
 
@@ -66,7 +66,7 @@ def test_unwrap_on_arrays_equals_the_float_one(scale: float) -> None:
     _same(out, [quaternion.unwrap_rotvec(p, r) for p, r in pairs])
 
 
-@pytest.mark.parametrize("cost", [schedule_cost, distance_cost])
+@pytest.mark.parametrize("cost", [schedule_error, tracking_score])
 def test_track_costs_on_arrays_equal_the_float_ones(cost) -> None:
     rng = np.random.default_rng(2)
     d = rng.normal(0, 0.3, (64, 6))
@@ -91,8 +91,8 @@ def test_numpy_scalars_take_the_float_path() -> None:
     Python float, as rewards are."""
     course = [np.float64(x) for x in (0.3, -0.2, 0.1, 1.0, 0, 0, 0, 0, 0.5, 0.1, -0.3, 1, 1)]
     for left in (0.4, -0.7):
-        assert type(schedule_cost((0.1, 0.2, 0.3), left, course, 0.1)) is float
-        assert type(distance_cost((0.1, 0.2, 0.3), left, course, 0.1)) is float
+        assert type(schedule_error((0.1, 0.2, 0.3), left, course, 0.1)) is float
+        assert type(tracking_score((0.1, 0.2, 0.3), left, course, 0.1)) is float
 
 
 def test_square_sum_sums_as_pythons_sum() -> None:
