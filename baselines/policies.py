@@ -13,7 +13,7 @@ unless the caller trusts them (``trust_model``, :func:`trusted_models`). A model
 behind ``VecNormalize`` gets the statistics ``sgc train`` saved beside it
 (:func:`vecnormalize_path`, :mod:`baselines.models.normalization`), so it sees the observations it
 was trained on. The expert and the comparison controllers read the planner's view; built on an
-env that observes another (the newest ids' learner's view) they act on the env's planner view
+env that observes another (the learner's view every id observes) they act on the env's planner view
 of its current state themselves (:mod:`baselines.common.planner_view`). Every policy has the
 SB3 signature
 ``predict(observation, state=None, episode_start=None, deterministic=True)``.

@@ -63,13 +63,15 @@ def push_rng(episode_seed: int) -> np.random.Generator:
     return np.random.default_rng([int(episode_seed), PUSH_STREAM])
 
 
-def _angular_impulse(base: Any, body: int, obs: np.ndarray, spin: np.ndarray) -> np.ndarray:
+def _angular_impulse(base: Any, body: int, spin: np.ndarray) -> np.ndarray:
     """World-frame angular impulse that changes the body's angular velocity by ``spin``.
 
     ``I_world = R diag(I) R^T``: scaling by the inertia matters for a rod, whose inertia about
-    its own axis is a hundred times smaller than across it.
+    its own axis is a hundred times smaller than across it. The orientation is the planner's
+    state (whatever the env observes).
     """
-    quat = obs[base.layout.body_slice(body, "orientation")].astype(float)
+    state = base.planner_observation()
+    quat = state[base.layout.body_slice(body, "orientation")].astype(float)
     rot = np.array(to_matrix(quat / np.linalg.norm(quat)))
     return rot @ (base.body_inertia[body] * (rot.T @ spin))
 
@@ -92,5 +94,5 @@ def apply_random_push(
     velocity = rng.normal(0.0, pushes.scale, 3)
     spin = rng.normal(0.0, pushes.spin, 3)
     linear = base.scenario.bodies[body].mass * velocity
-    angular = _angular_impulse(base, body, obs, spin) if base.use_torque else np.zeros(3)
+    angular = _angular_impulse(base, body, spin) if base.use_torque else np.zeros(3)
     return np.array(base.apply_impulse(body, linear, angular), dtype=np.float32)

@@ -1,7 +1,7 @@
 """The planner's view of an env's current state, for the policies that read it on any id.
 
 The expert and the comparison controllers decode the planner's observation
-(:mod:`sgc_env.observation`); the newest ids observe the learner's view. Every SGC env hands
+(:mod:`sgc_env.observation`); every id observes the learner's view. Every SGC env hands
 out the planner's view of its current state (``SGCEnv.planner_observation``), so a planner
 policy acts on the very state the learner sees: :func:`planner_observation` reads it from a
 plain, wrapped or vector env (one row per sub-env). :func:`planner_reader` is the one home of

@@ -12,7 +12,7 @@ same deadbeat actuation as :class:`~baselines.controllers.expert.SGCExpert`, so 
 
 Both keep a little per-episode state (one slot per sub-env of a vector env) and reset it at
 ``episode_start`` or whenever the observation's time is back at tick 0. On an env that
-observes another view than the planner's (the newest ids' learner's view) they act, as the
+observes another view than the planner's (the learner's view every id observes) they act, as the
 expert does, on the env's planner view of its current state
 (:func:`~baselines.common.planner_view.planner_reader`): ``predict`` must then be handed the
 observation that env just returned.

@@ -10,8 +10,8 @@ re-plan from.
 
 On an env of the planner's view the policy reads only the observation (plus the env's
 constants in :class:`EnvModel`), so it runs inside ``evaluate_policy``, vector envs and
-imitation tools, offline observations included. Built on an env of another view (the newest
-ids' learner's view) it acts on the env's planner view of its current state
+imitation tools, offline observations included. Built on an env of another view (the
+learner's view every id observes) it acts on the env's planner view of its current state
 (:func:`~baselines.common.planner_view.planner_reader`): it must then be asked about the
 observation that env just returned, which it checks.
 """

@@ -44,9 +44,7 @@ __all__ = [
 ]  # fmt: skip
 
 ENV_ID = "SGCThreeRods-v2"
-"""The paper's scene with the planner's view: the expert and the hand-written controllers fly it."""
-LEARNER_ENV_ID = "SGCThreeRods-v2"
-"""The same scene with the learner's view: models trained on the newest ids fly it."""
+"""The paper's scene: the expert, the hand-written controllers and learned models fly it."""
 PLATE_TIMES = (0.5, 1.25, 2.4, 3.6, 4.6, 5.8, 7.05, 8.3)
 """Moments the plates show: launch, piercing, flight, somersault, the hits, all three in."""
 ROD_DRAW_RADIUS = 0.075
@@ -222,27 +220,16 @@ def demo_policy(options: DemoOptions, env: Any) -> Any:
 
 
 def open_demo(options: DemoOptions) -> tuple[str, Any, Any]:
-    """The version of the paper's scene the policy flies (:data:`ENV_ID`, or
-    :data:`LEARNER_ENV_ID` for a model file whose observation is the learner's view), that env
-    (open: the caller closes it) and the policy on it; raises :func:`demo_policy`'s ValueError
-    (for the planner's version) when neither fits."""
+    """The id of the paper's scene (:data:`ENV_ID`), that env (open: the caller closes it) and
+    the policy on it; raises :func:`demo_policy`'s ValueError when the policy does not fit."""
     import gymnasium as gym
 
-    from baselines.models.model_files import ModelFileError
-
-    first: ModelFileError | None = None
-    for env_id in (ENV_ID, LEARNER_ENV_ID):
-        env = gym.make(env_id)
-        try:
-            return env_id, env, demo_policy(options, env)
-        except ModelFileError as exc:  # a model that does not fit; the other view may
-            env.close()
-            first = first or exc
-        except BaseException:
-            env.close()
-            raise
-    assert first is not None
-    raise first
+    env = gym.make(ENV_ID)
+    try:
+        return ENV_ID, env, demo_policy(options, env)
+    except BaseException:
+        env.close()
+        raise
 
 
 def demo_env_id(options: DemoOptions) -> str:

@@ -87,9 +87,9 @@ on every reset); ``control_frequency`` (default: the scenario's, 60 Hz), ``sim_f
 ``camera`` ("fixed": frames the whole scene, "tracking": follows the bodies, or a dict, see
 :class:`~sgc_env.render.scene.CameraSpec`), ``width``/``height`` (frame size, 640x480),
 ``reward`` (``"tracking"`` or a :class:`~sgc_env.envs.rewards.RewardMode`), ``observation``
-(``"learner"``, ``"planner"`` or an :class:`~sgc_env.envs.views.ObservationView`). ``reset(options={"scenario": ...})``
-swaps the scenario (same number of bodies and action size; a random-scenario env draws again
-on the next plain reset).
+(``"learner"``, ``"planner"`` or an :class:`~sgc_env.envs.views.ObservationView`).
+``reset(options={"scenario": ...})`` swaps the scenario (same number of bodies and action size;
+a random-scenario env draws again on the next plain reset).
 """
 
 from __future__ import annotations

@@ -109,3 +109,28 @@ def test_a_longer_episode_than_the_registered_limit_is_refused() -> None:
     with pytest.raises(ValueError, match="lasts 420 steps .* after 306; pass max_episode_steps"):
         vec.reset(seed=0)
     vec.close()
+
+
+EARLIER = {"SGCPoint-v0": "SGCPoint-v1", "SGCRod-v0": "SGCRod-v1",
+           "SGCThreeRods-v1": "SGCThreeRods-v2", "SGCIntercept-v0": "SGCIntercept-v1",
+           "SGCInterceptRandom-v0": "SGCInterceptRandom-v1", "SGCPointGoal-v0": "SGCPointGoal-v1",
+           "SGCThreeRodsRandom-v2": "SGCThreeRodsRandom-v3"}  # fmt: skip
+"""The versions before 1.0 and their current ids (CHANGELOG.md, "Migrating to 1.0")."""
+
+
+def test_one_version_per_task() -> None:
+    registered = [k for k in gym.registry if k.startswith("SGC")]
+    assert sorted(registered) == sorted(sgc_env.ENV_IDS) == sorted(EARLIER.values())
+
+
+@pytest.mark.parametrize("old", sorted(EARLIER))
+def test_an_earlier_version_is_gymnasiums_deprecated_env_naming_the_current(old: str) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # Gymnasium's own line before it
+        with pytest.raises(gym.error.DeprecatedEnv, match=f"Please use `{EARLIER[old]}`"):
+            gym.make(old)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the package's check says it once, without the line
+        with pytest.raises(ValueError, match=f"^--env: .*{old[-2:]} for `.*` is deprecated.*"
+                                             f"{EARLIER[old]}"):  # fmt: skip
+            sgc_env.check_env_id(old, "--env")

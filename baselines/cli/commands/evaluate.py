@@ -26,7 +26,6 @@ from baselines.cli.checks import (
     trust_model,
 )
 from sgc_env.defaults import EVAL_SEED, ORIENTATION_TOLERANCE, POSITION_TOLERANCE
-from sgc_env.envs.rewards import REWARD_MODES
 
 __all__ = ["add_arguments", "run"]
 
@@ -74,11 +73,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="print every scorecard column (default: a compact table that fits 80 columns)",
     )  # fmt: skip
     add_trust_argument(parser)
-    parser.add_argument(
-        "--reward", default=None, metavar="MODE",
-        help=f"the env's reward mode (gym.make(id, reward=MODE): {', '.join(REWARD_MODES)}); "
-        "default: the env's own",
-    )  # fmt: skip
 
 
 def _split(values: Sequence[str] | None, default: str) -> list[str]:
@@ -118,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     root = args.out or Path("runs/evaluate", *([envs[0], labels[0]] if single else []))
     pairs = evaluate_pairs(
         policies, labels, envs, episodes=args.episodes, seed=args.seed, tolerances=tolerances,
-        num_envs=args.num_envs, env_kwargs=None if args.reward is None else {"reward": args.reward},
+        num_envs=args.num_envs,
     )  # fmt: skip
     summaries = []
     # Written next to the output folder and moved in at the end: an interrupted run leaves

@@ -117,13 +117,13 @@ def test_learning_curve_uses_steps_every_run_has() -> None:
 
 
 def test_train_command_reproduces_the_options(tiny_hp: Path) -> None:
-    recipes = recipes_from_algos(["ppo"], str(tiny_hp), {"reward": "distance"}, 64)
+    recipes = recipes_from_algos(["ppo"], str(tiny_hp), {"observation": "planner"}, 64)
     (spec,) = build_grid(recipes, ["SGCPoint-v1"], [3], eval_freq=64, curve_episodes=1,
                          eval_episodes=2)  # fmt: skip
     command = train_command(spec.train_options(out="DIR"))
     assert command == (f"sgc train --algo ppo --env SGCPoint-v1 --seed 3 --timesteps 64 "
                        f"--out DIR --eval-freq 64 --eval-episodes 1 --hyperparams {tiny_hp} "
-                       "--env-kwargs '{\"reward\": \"distance\"}'")  # fmt: skip
+                       "--env-kwargs '{\"observation\": \"planner\"}'")  # fmt: skip
 
 
 @pytest.mark.parametrize(

@@ -67,20 +67,6 @@ def test_evaluate_reports_bad_arguments(tmp_path, capsys):
     assert cli.main(["evaluate", "--episodes", "0", "--out", str(tmp_path)]) == 2
 
 
-def test_evaluate_picks_the_reward_mode(tmp_path, capsys):
-    returns = {}
-    for mode in ("sparse", "distance"):
-        out = tmp_path / mode
-        argv = ["evaluate", "--env", "SGCPoint-v1", "--policy", "expert", "--episodes", "1",
-                "--reward", mode, "--no-plots", "--out", str(out)]  # fmt: skip
-        assert cli.main(argv) == 0
-        returns[mode] = json.loads((out / "summary.json").read_text())["return_mean"]
-    # sparse: the three exact goal bonuses minus a little effort; distance: a dense cost
-    assert 2.9 < returns["sparse"] < 3.0 and returns["distance"] < -10
-    assert cli.main(["evaluate", "--reward", "dense", "--out", str(tmp_path / "x")]) == 2
-    assert "reward: unknown mode 'dense'" in capsys.readouterr().err
-
-
 def test_evaluate_keeps_models_with_the_same_file_name_apart(tmp_path, capsys):
     shipped = SHIPPED / "ppo_dagger_SGCPoint-v1.zip"
     specs = []

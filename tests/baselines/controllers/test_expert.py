@@ -183,7 +183,7 @@ def test_on_the_learner_view_a_state_other_than_the_envs_is_refused():
 
 def test_on_the_planner_view_offline_observations_are_read_as_they_are():
     """The planner's view needs no env state: any observation of it gets its action."""
-    env = gym.make("SGCRod-v1")
+    env = gym.make("SGCRod-v1", observation="planner")
     expert = SGCExpert(env)
     obs, _ = env.reset(seed=0)
     first, _ = expert.predict(obs)
@@ -245,7 +245,7 @@ def test_expert_reads_goal_conditioned_observations():
 
 
 def test_expert_rejects_a_wrong_observation():
-    env = gym.make("SGCPoint-v1")
+    env = gym.make("SGCPoint-v1", observation="planner")  # read as handed: checked as handed
     with pytest.raises(ValueError, match="observation has shape"):
         SGCExpert(env).predict(np.zeros(5))
     obs, _ = env.reset(seed=0)

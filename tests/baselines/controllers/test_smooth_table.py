@@ -62,7 +62,7 @@ def test_expert_smooth_meets_every_goal_within_2x_of_minimum_jerk_on_a_rod():
 
 
 def test_expert_smooth_needs_its_scenario_and_falls_back_on_another():
-    env = gym.make("SGCRod-v1")
+    env = gym.make("SGCRod-v1", observation="planner")  # model-only experts read it as handed
     model = SGCExpert(env).model
     with pytest.raises(ValueError, match="needs the env or the episode's scenario"):
         SGCExpert(model=model, end_rule="smooth")
@@ -87,7 +87,7 @@ def test_expert_smooth_absorbs_a_push():
     errors, tick, done = [], 0, False
     while not done:
         if tick == 40:
-            env.unwrapped.apply_impulse(0, (0.3, 0.0, 0.2))
+            obs = env.unwrapped.apply_impulse(0, (0.3, 0.0, 0.2))  # the state after the push
         action, _ = policy.predict(obs, episode_start=np.array([tick == 0]))
         obs, _, terminated, truncated, info = env.step(action)
         done, tick = terminated or truncated, tick + 1

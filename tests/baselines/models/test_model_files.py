@@ -197,7 +197,7 @@ def _shadowing_field(clean: Path, tmp: Path) -> Path:
 
 
 def _other_env(clean: Path, tmp: Path) -> Path:
-    return SHIPPED / "ppo_dagger_SGCRod-v1.zip"  # trained on the rod: 6 actions, not 3
+    return _clean_model(tmp / "rod.zip", "SGCRod-v1")  # trained on the rod: 6 actions, not 3
 
 
 def _wrong_statistics(clean: Path, tmp: Path) -> Path:
@@ -263,9 +263,7 @@ def test_shipped_models_hold_no_pickle_beside_them() -> None:
     assert not list(SHIPPED.glob("*.pkl"))
     assert sorted(p.name for p in SHIPPED.glob("*.vecnormalize.json")) == [
         "ppo_caps_SGCThreeRodsRandom-v3.vecnormalize.json",
-        "ppo_point500k_SGCPoint-v1.vecnormalize.json", "ppo_rod300_SGCRod-v1.vecnormalize.json",
-        "ppo_schedule_SGCPoint-v1.vecnormalize.json", "ppo_schedule_SGCRod-v1.vecnormalize.json",
-    ]  # fmt: skip
+    ]
 
 
 def test_demo_refuses_a_model_of_other_spaces_before_unpickling(
@@ -280,19 +278,33 @@ def test_demo_refuses_a_model_of_other_spaces_before_unpickling(
     assert not marker.exists() and not (tmp_path / "demo").exists()
 
 
-def test_shipped_models_name_classes_by_their_old_paths_and_those_are_allowed() -> None:
-    """Most shipped zips were saved before the model classes moved to ``baselines.models``:
-    the classes they name by the old module paths are on the allow-list, as today's classes,
-    and every class a shipped zip names is allowed."""
-    from baselines.models.model_files import MOVED_MODULES, allowed_classes, read_model_data
+def test_every_class_a_shipped_model_names_is_allowed() -> None:
+    from baselines.models.model_files import allowed_classes, read_model_data
 
     named = set()
     for model in sorted(SHIPPED.glob("*.zip")):
         data, _ = read_model_data(model.read_bytes(), str(model))
         named |= set(re.findall(r"<class '(baselines\.[\w.]+)'>", json.dumps(data)))
-    old = {name for name in named if name.rpartition(".")[0] in MOVED_MODULES}
-    allowed = allowed_classes()
-    assert old and all(name in allowed for name in named), named
-    for name in old:
-        module, _, qualname = name.rpartition(".")
-        assert allowed[name] is allowed[f"{MOVED_MODULES[module]}.{qualname}"]
+    assert named and all(name in allowed_classes() for name in named), named
+
+
+def test_a_model_of_sgc_before_1_0_is_refused_in_one_line_saying_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """Files saved before 1.0 name the model classes by their old modules: one line says what
+    the file is and what to do (nothing is unpickled)."""
+    shipped = SHIPPED / "ppo_caps_SGCThreeRodsRandom-v3.zip"
+    with zipfile.ZipFile(shipped) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    members["data"] = members["data"].replace(b"baselines.models.", b"baselines.agents.")
+    old = tmp_path / "old.zip"
+    with zipfile.ZipFile(old, "w") as archive:
+        for name, blob in members.items():
+            archive.writestr(name, blob)
+    argv = ["evaluate", "--policy", str(old), "--env", "SGCThreeRodsRandom-v3", "--episodes",
+            "1", "--no-plots", "--out", str(tmp_path / "ev")]  # fmt: skip
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "old.zip" in err, err
+    assert "baselines.agents.per_body.PerBodyPolicy' of sgc before 1.0" in err
+    assert "Migrating to 1.0" in err
