@@ -282,8 +282,8 @@ STATS = {"format": "sgc-vecnormalize-1", "norm_obs": True, "norm_reward": False,
 
 
 def _stats(obs_var: str = "1.0", **settings: Any) -> str:
-    rms = (f'{{"shape": [78], "mean": [{", ".join(["0.0"] * 78)}], '
-           f'"var": [{obs_var}{", 1.0" * 77}], "count": 1.0}}')  # fmt: skip
+    rms = (f'{{"shape": [50], "mean": [{", ".join(["0.0"] * 50)}], '
+           f'"var": [{obs_var}{", 1.0" * 49}], "count": 1.0}}')  # fmt: skip
     text = json.dumps({**STATS, **settings, "obs_rms": "RMS"})
     return text.replace('"RMS"', rms)
 
@@ -306,7 +306,7 @@ MODELS: dict[str, Case] = {
                                 "not weights SB3 writes"),
     "gains_env of a foreign env": Case(_model(
         _foreign_gains_env, env="SGCThreeRodsRandom-v3",
-        source=SHIPPED / "ppo_perbody_SGCThreeRodsRandom-v3.zip"), "gains_env must be an SGC"),
+        source=SHIPPED / "ppo_caps_SGCThreeRodsRandom-v3.zip"), "gains_env must be an SGC"),
     "escapes in a space dtype": Case(_model(_space_dtype), "does not fit"),
     "escapes in config.json env_id": Case(_beside("config.json", json.dumps({"env_id": ANSI})),
                                           "trained on"),
@@ -419,7 +419,7 @@ RESULTS: dict[str, Case] = {
 
 def _npz(tmp: Path, replace: dict[str, bytes] | None = None, **arrays: Any) -> Path:
     rows = 4
-    obs = np.zeros((rows, 78), np.float32)
+    obs = np.zeros((rows, 50), np.float32)
     content = dict(observations=obs, actions=np.zeros((rows, 3), np.float32),
                    rewards=np.zeros(rows, np.float32), terminations=np.zeros(rows, bool),
                    truncations=np.zeros(rows, bool), episode_starts=np.ones(rows, bool),
@@ -446,7 +446,7 @@ def _demos(make: Callable[[Path], Path]) -> Callable[[Path, Path], tuple[list[st
 def _claimed_rows(tmp: Path) -> Path:
     header = io.BytesIO()
     np.lib.format.write_array_header_1_0(
-        header, {"descr": "<f4", "fortran_order": False, "shape": (10**12, 78)})
+        header, {"descr": "<f4", "fortran_order": False, "shape": (10**12, 50)})
     return _npz(tmp, {"observations.npy": header.getvalue() + bytes(64)})
 
 

@@ -1,6 +1,5 @@
-"""The learner's view: bounded, float32, and the same on-schedule features the policy-side
-extractor computes (an independent implementation in torch,
-:mod:`baselines.models.schedule_features`)."""
+"""The learner's view: bounded, float32, and the on-schedule features an independent reading
+of the planner's view gives."""
 
 from __future__ import annotations
 
@@ -47,30 +46,47 @@ def test_view_is_float32_inside_its_bounds(env_id: str) -> None:
     assert np.all(np.abs(low) <= 3.0) and np.all(np.abs(high) <= 3.0)
 
 
-def test_on_schedule_entries_match_the_policy_side_extractor() -> None:
-    """Error, rate and schedule velocities of the position track equal ScheduleFeatures' (the
-    torch extractor reads the float32 planner observation, so they agree to float32)."""
-    th = pytest.importorskip("torch")
-    from baselines.models.schedule_features import ScheduleFeatures
+def _on_schedule_reference(obs: np.ndarray, layout, track: str) -> np.ndarray:
+    """Error and rate against the schedule (squashed, scales 0.05 and 0.5), the schedule's
+    velocity and the next course's (squashed), from the planner's view in float64: an
+    independent reading of the same rule (docs/environments.md)."""
+    rate_field = "point_velocity" if track == "position" else "angular_velocity"
 
-    env = gym.make("SGCRod-v1")
+    def get(name: str) -> np.ndarray:
+        return obs[layout.body_slice(0, name)].astype(np.float64)
+
+    deviation, rate = get(f"{track}_deviation"), get(rate_field)
+    left, duration = get(f"{track}_time_left")[0], get(f"{track}_course_duration")[0]
+    start, end = get(f"{track}_course_start"), get(f"{track}_end_velocity")
+    next_start, next_duration = get(f"{track}_next_start"), get(f"{track}_next_duration")[0]
+    in_course = left >= 0 and duration > 0
+    schedule = start * left / duration if in_course else -end * left
+    schedule_rate = -start / duration if in_course else end
+    next_rate = -next_start / next_duration if next_duration > 0 else np.zeros(3)
+
+    def squash(x: np.ndarray) -> np.ndarray:
+        return 3.0 * np.tanh(x / 3.0)
+
+    error, error_rate = (deviation - schedule) / 0.05, (rate - schedule_rate) / 0.5
+    return np.concatenate([squash(error), squash(error_rate), squash(schedule_rate),
+                           squash(next_rate)])  # fmt: skip
+
+
+def test_on_schedule_entries_match_an_independent_reading_of_the_planner_view() -> None:
+    """Error, rate and schedule velocities of both tracks equal a float64 reading of the
+    float32 planner observation (so they agree to float32)."""
+    env = gym.make("SGCRod-v1", observation="planner")
     obs, _ = env.reset(seed=3)
-    rows, views = [], []
+    layout = env.unwrapped.layout
     for _ in range(60):
         obs, *_ = env.step(env.action_space.sample() * 0.2)
-        rows.append(obs)
-        views.append(learner_observation(env.unwrapped._block[None], np.zeros((1, 1, 3)),
-                                         np.zeros(1))[0])  # fmt: skip
-    extractor = ScheduleFeatures(env.observation_space, gravity=0.0, squash=3.0)
-    with th.no_grad():
-        features = extractor(th.as_tensor(np.stack(rows))).numpy()
-    mine = np.stack(views)
-    # ScheduleFeatures: error 3, rate 3 (squashed), schedule rate 3, next rate 3 (not squashed)
-    for start in (6, 22):
-        features[:, start : start + 6] = 3.0 * np.tanh(features[:, start : start + 6] / 3.0)
-    np.testing.assert_allclose(mine[:, 0:12], features[:, 0:12], atol=2e-4)
-    o = LEARNER_TRACK_SIZE
-    np.testing.assert_allclose(mine[:, o : o + 12], features[:, 16:28], atol=2e-4)
+        view = learner_observation(env.unwrapped._block[None], np.zeros((1, 1, 3)),
+                                   np.zeros(1))[0]  # fmt: skip
+        np.testing.assert_allclose(view[0:12], _on_schedule_reference(obs, layout, "position"),
+                                   atol=2e-4)  # fmt: skip
+        o = LEARNER_TRACK_SIZE
+        np.testing.assert_allclose(view[o : o + 12],
+                                   _on_schedule_reference(obs, layout, "orientation"), atol=2e-4)
     env.close()
 
 

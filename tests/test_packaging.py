@@ -38,7 +38,7 @@ def test_shipped_models_resolve_and_load() -> None:
     assert resolve_policy_spec("shipped:SGCPoint-v1") == models["SGCPoint-v1"]
     for stem, path in shipped_files().items():
         assert resolve_policy_spec(f"shipped:{stem}") == path
-    assert "ppo_schedule_SGCPoint-v1" in shipped_files()  # the model learned without demos
+    assert "ppo_caps_SGCThreeRodsRandom-v3" in shipped_files()  # learned without demos
     assert resolve_policy_spec("expert") == "expert"
     env = gym.make("SGCPoint-v1")
     obs, _ = env.reset(seed=0)
