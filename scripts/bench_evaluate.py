@@ -5,8 +5,8 @@
 Prints the median of ``--rounds`` runs of each and their ratio. A model file warms up (imports,
 load) before timing.
 
-    PYTHONPATH=$PWD .venv/bin/python scripts/bench_evaluate.py --env SGCRod-v1 \\
-        --policy expert baselines/checkpoints/ppo_schedule_SGCRod-v1.zip --episodes 8
+    PYTHONPATH=$PWD .venv/bin/python scripts/bench_evaluate.py --env SGCPoint-v1 \\
+        --policy expert baselines/checkpoints/ppo_dagger_SGCPoint-v1.zip --episodes 8
 """
 
 from __future__ import annotations

@@ -8,7 +8,9 @@ run (the first ``--configs`` entry), each in a fresh child process, one after th
 ``--steps`` env steps, no evaluation::
 
     .venv/bin/python scripts/bench_recipes.py --env SGCRod-v1 --steps 32768 \
-        --configs ppo_schedule:dummy ppo_schedule:batched ppo_rod_alive64:batched ppo_rod300:batched
+        --configs zoo:dummy zoo:batched
+
+A FOLDER is relative to ``benchmarks/`` (``zoo``: rl-zoo3's files; ``hyperparams/NAME``).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-HYPERPARAMS = Path(__file__).resolve().parents[1] / "benchmarks" / "hyperparams"
+HYPERPARAMS = Path(__file__).resolve().parents[1] / "benchmarks"
 
 
 def child(env_id: str, folder: str, vec: str, steps: int) -> dict[str, float]:
@@ -36,7 +38,7 @@ def main() -> None:
     parser.add_argument("--env", default="SGCRod-v1")
     parser.add_argument("--steps", type=int, default=32768, help="env steps per timed run")
     parser.add_argument("--configs", nargs="+",
-                        default=["ppo_schedule:dummy", "ppo_rod300:batched"],
+                        default=["zoo:dummy", "zoo:batched"],
                         help="FOLDER:VEC; the first is the reference")  # fmt: skip
     parser.add_argument("--repeats", type=int, default=1)
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)

@@ -3,7 +3,7 @@
 They resolve the same way in a checkout and in an installed wheel, so ``sgc`` works from any
 directory. A shipped model is named in a policy spec as ``shipped:<env id>`` (the BC+DAgger
 model of that id) or ``shipped:<file stem>`` (any model, e.g.
-``shipped:ppo_schedule_SGCPoint-v1``).
+``shipped:ppo_caps_SGCThreeRodsRandom-v3``).
 """
 
 from __future__ import annotations

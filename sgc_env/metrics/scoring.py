@@ -151,11 +151,11 @@ def _orientation_goal_metrics(
 
 
 def _goal_met(traj: BodyTrajectory, goal: GoalSpec, tol: Tolerances) -> bool:
-    """Met iff at some instant within time tolerance of t_i every part is within tolerance."""
+    """Met iff every part is within tolerance at t_i (interpolated between ticks), or, with a
+    time tolerance, at a tick within it of t_i."""
     if _after_end(traj, goal):
         return False
-    time_tol = traj.dt if tol.time is None else tol.time
-    ticks = sg.in_window(traj.times, goal.time - time_tol, goal.time + time_tol)
+    ticks = sg.in_window(traj.times, goal.time - tol.time, goal.time + tol.time)
     ok_at_ticks = np.ones(ticks.size, dtype=bool)
     ok_at_goal = True
     if goal.nail is not None:

@@ -64,8 +64,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="RAD", help="success: orientation error at the goal's tick within this",
     )  # fmt: skip
     parser.add_argument(
-        "--tolerance-time", type=nonneg_float, default=None, metavar="S",
-        help="success time tolerance (default: one control step)",
+        "--tolerance-time", type=nonneg_float, default=0.0, metavar="S",
+        help="success: also count a tick within S seconds of the goal's time (default 0: "
+        "at the goal's time only)",
     )  # fmt: skip
     parser.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     parser.add_argument(

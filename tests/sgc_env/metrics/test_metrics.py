@@ -280,6 +280,20 @@ def test_goal_between_ticks_is_interpolated():
     assert card["success_rate"] == 1.0
 
 
+def test_met_is_the_state_at_the_goals_own_time() -> None:
+    """One tick late is a miss by default; a time tolerance is an explicit option that counts
+    the tick within it."""
+    late = BodyTrajectory.from_infos(spline_rollout(DT), 0, DT)  # one tick behind the spline
+    goals = spline_goals()[:2]  # both reached at speed: a tick late is about a centimetre off
+    strict = Tolerances(position=0.005)
+    by_default = score_body(late, goals, tolerances=strict)
+    assert by_default["goals_met"] == 0
+    assert all(row["position_error"] > 0.005 for row in by_default["position_goals"])
+    loose = score_body(late, goals, tolerances=Tolerances(position=0.005, time=DT))
+    assert loose["goals_met"] == len(goals)
+    assert Tolerances().time == 0.0
+
+
 def test_dynamic_constraints_rollout_shows_the_figure_1_pathology():
     eps = 1e-3
     taus = [
