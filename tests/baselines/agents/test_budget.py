@@ -168,8 +168,8 @@ def test_leaderboard_shows_budget_steps_reached_and_both_curves(tmp_path: Path) 
 
 def test_the_sweep_script_runs_every_budget_recipe() -> None:
     text = (ROOT / "scripts" / "run_budget_rows.sh").read_text()
-    rows = {name for line in text.splitlines() if line.startswith("ROWS=")
-            for name in line.split("=", 1)[1].replace("$ROWS,", "").split(",")}  # fmt: skip
+    rows = {name for line in text.splitlines() if line.startswith("ALL=")
+            for name in line.split("=", 1)[1].replace("$ALL,", "").split(",")}  # fmt: skip
     recipes = load_recipes(ROOT / "benchmarks" / "recipes.yml")
     assert rows == {r.name for r in recipes if r.time_budget_s is not None}
 
