@@ -27,14 +27,16 @@ exact to 1e-15 (the expert) reads the planner's view of the same state, which ev
 out as ``env.unwrapped.planner_observation()``.
 
 The view is computed from the step's double-precision record (one row per sub-env) and the
-sub-env's :meth:`LearnerView.constants` (the hovering action, the episode's length), so the
-single env (one row) and the batched env (N rows) share this one function.
+sub-env's :meth:`LearnerView.constants` (the hovering action, the episode's length) by one
+rule, :func:`_track`: on arrays for the batched env (N rows), on floats for one env, whose
+per-course terms it caches from one goal switch to the next (numpy's per-call overhead dwarfs
+one env's arithmetic). The same float operations and numpy's one tanh give the same bits.
 """
 
 from __future__ import annotations
 
-import functools
 import operator
+import struct
 from collections.abc import Sequence
 from typing import Any
 
@@ -182,48 +184,154 @@ def _squash(raw: np.ndarray, has: np.ndarray | None) -> np.ndarray:
     return raw
 
 
-@functools.cache
-def _order(n_bodies: int) -> np.ndarray:
-    """Where each entry of one env's view sits in the list :func:`_observe_one` builds (the
-    squashed entries of every track, the tracks' flags ``has``, then the rest in view order)."""
-    squashed = 2 * n_bodies * _RAW
-    tail = squashed + 2 * n_bodies
-    order: list[int] = []
-    for j in range(n_bodies):
-        for k in (2 * j, 2 * j + 1):
-            order += range(k * _RAW, (k + 1) * _RAW)
-            order += range(tail + 5 * k, tail + 5 * k + 5)
-        order += range(tail + 10 * n_bodies + 3 * j, tail + 10 * n_bodies + 3 * j + 3)
-    order.append(tail + 13 * n_bodies)
-    return np.array(order)
+_COURSE = struct.Struct(f"={_COURSE_SIZE}d")
+_FLOAT64 = np.dtype(np.float64)
+_ZEROS = (0.0, 0.0, 0.0)  # the next goal's entries when there is none
 
 
-def _observe_one(record: list[float], constants: list[float], n_bodies: int) -> np.ndarray:
-    """One env's view from its record and constants as floats: the rule on floats, one track
-    at a time (numpy's per-call overhead dwarfs a few bodies' arithmetic), and the squash on
-    one array."""
-    raw: list[float] = []
-    flags: list[float] = []
-    tails: list[float] = []
-    for j in range(n_bodies):
-        o = j * BODY_BLOCK_SIZE
-        for d, r, t, c in _TRACK_COLUMNS:
-            d, r, t, c = d + o, r + o, t + o, c + o
-            entries, tail = _track(
-                record[d : d + 3], record[r : r + 3], record[t], record[c : c + 3],
-                record[c + 3], record[c + 4 : c + 7], record[c + 7], record[c + 8 : c + 11],
-                record[c + 11], record[c + 12],
-            )  # fmt: skip
-            raw += entries
-            flags.append(tail[3])
-            tails += tail
-    tails += [_clip(h, -1.0, 1.0) for h in constants[:-1]]
-    tails.append(_clip(record[n_bodies * BODY_BLOCK_SIZE] * constants[-1], 0.0, 1.0))
-    values = np.fromiter(raw + flags + tails, np.float64)
-    size = len(raw)
-    has = None if flags.count(1.0) == len(flags) else values[size : size + len(flags), None]
-    _squash(values[:size].reshape(-1, _RAW), has)
-    return values[_order(n_bodies)].astype(np.float32)
+def _course_terms(course: list[float]) -> tuple[Any, ...]:
+    """What :func:`_track` computes from a track's course entries alone (start, duration, next
+    start and duration, end velocity, flags), by the same float operations: they hold from one
+    goal switch to the next, so one env computes them once per course."""
+    c0, span, c1, next_span, v_end = course[0:3], course[3], course[4:7], course[7], course[8:11]
+    on = span > 0.0
+    safe = span if on else 1.0
+    rate_in = [-x / safe for x in c0]
+    has_next = next_span > 0.0
+    next_safe = next_span if has_next else 1.0
+    next_rate = [-x / next_safe for x in c1] if has_next else [0.0] * 3
+    return (
+        on, safe, *c0, *[-x for x in v_end], *rate_in, *v_end, (*rate_in, *next_rate),
+        (*v_end, *next_rate), has_next, *c1, next_span, course[11], course[12],
+    )  # fmt: skip
+
+
+def _reader(fields: list[tuple[int, int, bool]]) -> tuple[struct.Struct, list[int]]:
+    """One struct that reads ``fields`` (first column, entries, whether as raw bytes) of a
+    float64 record and skips the rest (one C call, no float made for an entry not read), and
+    where each field starts in what it gives."""
+    fmt, column, index = "=", 0, 0
+    starts: dict[tuple[int, int, bool], int] = {}
+    for field in sorted(fields):
+        first, count, raw = field
+        if first < column:
+            raise ValueError("learner view: overlapping record fields")
+        fmt += f"{8 * (first - column)}x" if first > column else ""
+        fmt += f"{8 * count}s" if raw else f"{count}d"
+        starts[field] = index
+        index += 1 if raw else count
+        column = first + count
+    return struct.Struct(fmt), [starts[field] for field in fields]
+
+
+class _OneEnv:
+    """One env's view: :func:`_track`'s rule on floats with its per-course terms cached
+    (numpy's per-call overhead dwarfs a few bodies' arithmetic; a float division costs more
+    than an array's), then :func:`_squash`, the view's order and the cast on one work buffer.
+
+    A track's cache is keyed by the bytes of its course entries (bit for bit: ``0.0 == -0.0``
+    would not do), so a goal switch, a reset or a new scene refreshes it without being told.
+    ``observe`` gives None for a record that is not contiguous float64 (the array path's).
+    """
+
+    def __init__(self, layout: ObservationLayout) -> None:
+        n = layout.n_bodies
+        tracks = [(d + o, r + o, t + o, c + o)
+                  for o in range(0, n * BODY_BLOCK_SIZE, BODY_BLOCK_SIZE)
+                  for d, r, t, c in _TRACK_COLUMNS]  # fmt: skip
+        fields = [(n * BODY_BLOCK_SIZE, 1, False)]  # the time
+        for d, r, t, c in tracks:
+            fields += [(d, 3, False), (r, 3, False), (t, 1, False), (c, _COURSE_SIZE, True)]
+        reader, starts = _reader(fields)
+        self.read = reader.unpack_from
+        self.time_at = starts[0]
+        self.getters = [
+            operator.itemgetter(d, d + 1, d + 2, r, r + 1, r + 2, t)
+            for d, r, t in zip(starts[1::4], starts[2::4], starts[3::4], strict=True)
+        ]
+        self.courses = operator.itemgetter(*starts[4::4])
+        self.keys: tuple[bytes, ...] = ()
+        self.terms: list[tuple[Any, ...]] = []
+        self.has: np.ndarray | None = None
+        self.constants: np.ndarray | None = None
+        self.hover: list[float] = []
+        self.inverse_length = 0.0
+        size = learner_size(n)
+        squashed = len(tracks) * _RAW
+        self.pack = struct.Struct(f"={size}d").pack_into
+        self.values = np.zeros(size)  # raw entries, tails, hover actions, episode fraction
+        self.raw = self.values[:squashed].reshape(len(tracks), _RAW)
+        hover = squashed + 5 * len(tracks)
+        order: list[int] = []
+        for j in range(n):
+            for k in (2 * j, 2 * j + 1):
+                order += range(k * _RAW, (k + 1) * _RAW)
+                order += range(squashed + 5 * k, squashed + 5 * k + 5)
+            order += range(hover + 3 * j, hover + 3 * j + 3)
+        order.append(size - 1)
+        self.order = np.array(order)
+
+    def _switch(self, keys: tuple[bytes, ...]) -> None:
+        """New courses: their terms, and the flags :func:`_squash` multiplies by."""
+        self.keys = keys
+        self.terms = [_course_terms(list(_COURSE.unpack(key))) for key in keys]
+        flags = [terms[-2] for terms in self.terms]
+        self.has = None if flags.count(1.0) == len(flags) else np.array(flags)[:, None]
+
+    def _bind_constants(self, constants: np.ndarray) -> None:
+        """The hover actions clipped and the inverse length; a read-only array (what
+        :meth:`LearnerView.constants` gives) is kept, so the next step checks its identity."""
+        const = constants.tolist()
+        self.hover = [_clip(h, -1.0, 1.0) for h in const[:-1]]
+        self.inverse_length = const[-1]
+        self.constants = None if constants.flags.writeable else constants
+
+    def observe(self, record: np.ndarray, constants: np.ndarray) -> np.ndarray | None:
+        dtype = record.dtype
+        if dtype is not _FLOAT64 and dtype != _FLOAT64:  # (an unpickled one is a copy)
+            return None
+        try:
+            fields = self.read(record)  # type: ignore[arg-type]  # an ndarray is a buffer
+        except (ValueError, struct.error):  # not contiguous, or too short: the array path
+            return None
+        keys = self.courses(fields)
+        if keys != self.keys:
+            self._switch(keys)
+        if constants is not self.constants:
+            self._bind_constants(constants)
+        lo, hi = TIME_LOW, TIME_HIGH
+        raw: list[float] = []
+        tails: list[float] = []
+        for get, terms in zip(self.getters, self.terms, strict=True):
+            dx, dy, dz, rx, ry, rz, t = get(fields)
+            (on, safe, c0x, c0y, c0z, nvx, nvy, nvz, ix, iy, iz, vx, vy, vz, rates_in,
+             rates_out, has_next, c1x, c1y, c1z, next_span, has, last) = terms  # fmt: skip
+            if t >= 0.0 and on:
+                f = t / safe
+                raw += (dx - c0x * f, dy - c0y * f, dz - c0z * f, rx - ix, ry - iy, rz - iz)
+                raw += rates_in
+                phase = has * (0.0 if f <= 0.0 else 1.0 if f >= 1.0 else f)
+            else:
+                raw += (dx - nvx * t, dy - nvy * t, dz - nvz * t, rx - vx, ry - vy, rz - vz)
+                raw += rates_out
+                phase = has * 0.0
+            raw += (-dx, -dy, -dz)
+            if has_next:
+                raw += (-(dx + c1x), -(dy + c1y), -(dz + c1z))
+                u = t + next_span
+                ahead = lo if u <= lo else hi if u >= hi else u
+            else:
+                raw += _ZEROS
+                ahead = 0.0
+            left = lo if t <= lo else hi if t >= hi else t
+            tails += (phase, has * left, has * ahead, has, last)
+        fraction = fields[self.time_at] * self.inverse_length
+        raw += tails
+        raw += self.hover
+        raw.append(0.0 if fraction <= 0.0 else 1.0 if fraction >= 1.0 else fraction)
+        self.pack(self.values, 0, *raw)  # type: ignore[arg-type]  # an ndarray is a buffer
+        _squash(self.raw, self.has)
+        return self.values.take(self.order).astype(np.float32)
 
 
 def learner_observation(
@@ -268,13 +376,27 @@ class LearnerView(ObservationView):
         act = env._actuation
         gravity = np.asarray(act._gravity, dtype=np.float64)
         hover = [-m * gravity / f for m, f in zip(act._mass, act._flimit, strict=True)]
-        return np.array([*np.concatenate(hover), 1.0 / (env.max_steps * env.dt)])
+        constants = np.array([*np.concatenate(hover), 1.0 / (env.max_steps * env.dt)])
+        constants.flags.writeable = False  # fixed: one env's view checks it by identity
+        return constants
+
+    _one: _OneEnv | None = None
+
+    def bind(self, layout: ObservationLayout) -> ObservationView:
+        view = super().bind(layout)
+        view._one = None  # type: ignore[attr-defined]  # each env its own cache
+        return view
 
     def observe(self, record: np.ndarray, constants: np.ndarray | None = None) -> np.ndarray:
+        if record.ndim == 1 and constants is not None and constants.size:  # one env's step
+            one = self._one
+            if one is None:
+                one = self._one = _OneEnv(self.layout)
+            view = one.observe(record, constants)
+            if view is not None:
+                return view
         n_bodies = self.layout.n_bodies
         size = self.layout.size
-        if record.ndim == 1 and constants is not None and constants.size:  # one env's step
-            return _observe_one(record[:size].tolist(), constants.tolist(), n_bodies)
         rows = record.reshape(-1, record.shape[-1])
         block = rows[:, : size - 1].reshape(len(rows), n_bodies, BODY_BLOCK_SIZE)
         if constants is None or constants.size == 0:
