@@ -361,8 +361,8 @@ def learner_observation(
 
 @observation_view
 class LearnerView(ObservationView):
-    """The learner's view (module docstring), ``observation="learner"``: the default of the
-    ids' newest versions."""
+    """The learner's view (module docstring), ``observation="learner"``: every registered id's
+    and the env's default."""
 
     name = "learner"
 

@@ -39,7 +39,7 @@ def _hover(env: gym.Env) -> np.ndarray:
     return action
 
 
-@pytest.mark.parametrize("env_id", sgc_env.LEARNER_IDS)
+@pytest.mark.parametrize("env_id", sgc_env.ENV_IDS)
 def test_one_env_equals_the_array_path_on_real_episodes(env_id: str) -> None:
     env = gym.make(env_id)
     base = env.unwrapped
