@@ -37,10 +37,9 @@ def test_manifest_entries_are_consistent() -> None:
     for entry in ENTRIES:
         assert entry["env_id"] in sgc_env.ENV_IDS
         assert entry["algo"] in ("ppo", "sac", "td3", "her")
-        assert (
-            entry["command"].startswith("sgc train")
-            and f"--env {entry['env_id']}" in (entry["command"])
-        )
+        steps = [part.strip() for part in entry["command"].split("&&")]  # demos, then train
+        assert all(step.startswith("sgc ") for step in steps), entry["command"]
+        assert steps[-1].startswith("sgc train") and f"--env {entry['env_id']}" in steps[-1]
         result = entry["result"]
         assert 0 <= result["goals_met"] <= result["n_goals"]
         assert result["success_rate"] == pytest.approx(result["goals_met"] / result["n_goals"])
