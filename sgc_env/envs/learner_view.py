@@ -46,6 +46,7 @@ import numpy as np
 from sgc_env.observation import BODY_BLOCK_SIZE, ObservationLayout
 from sgc_env.paper.elementwise import where
 
+from .schedule import on_schedule
 from .views import ObservationView, observation_view
 
 __all__ = [
@@ -147,11 +148,7 @@ def _track(
     duration, the end velocity and the flags. Past the course's end (``t < 0``) the schedule
     runs on at the end velocity.
     """
-    in_course = (t >= 0.0) & (span > 0.0)
-    safe = where(span > 0.0, span, 1.0)
-    fraction = t / safe
-    schedule = _pick(in_course, [x * fraction for x in c0], [-x * t for x in v_end])
-    rate = _pick(in_course, [-x / safe for x in c0], list(v_end))
+    schedule, rate, in_course, fraction = on_schedule(c0, span, v_end, t)
     has_next = next_span > 0.0
     zero = [0.0] * len(d)
     next_safe = where(has_next, next_span, 1.0)
@@ -190,20 +187,15 @@ _ZEROS = (0.0, 0.0, 0.0)  # the next goal's entries when there is none
 
 
 def _course_terms(course: list[float]) -> tuple[Any, ...]:
-    """What :func:`_track` computes from a track's course entries alone (start, duration, next
-    start and duration, end velocity, flags), by the same float operations: they hold from one
-    goal switch to the next, so one env computes them once per course."""
+    """What :func:`_track` reads of a track's course entries alone (start, duration, next start
+    and duration, end velocity, flags) and the next course's schedule velocity, by the same
+    float operations: they hold from one goal switch to the next, so one env makes them once
+    per course."""
     c0, span, c1, next_span, v_end = course[0:3], course[3], course[4:7], course[7], course[8:11]
-    on = span > 0.0
-    safe = span if on else 1.0
-    rate_in = [-x / safe for x in c0]
     has_next = next_span > 0.0
     next_safe = next_span if has_next else 1.0
-    next_rate = [-x / next_safe for x in c1] if has_next else [0.0] * 3
-    return (
-        on, safe, *c0, *[-x for x in v_end], *rate_in, *v_end, (*rate_in, *next_rate),
-        (*v_end, *next_rate), has_next, *c1, next_span, course[11], course[12],
-    )  # fmt: skip
+    next_rate = tuple(-x / next_safe for x in c1) if has_next else _ZEROS
+    return (c0, span, v_end, next_rate, has_next, *c1, next_span, course[11], course[12])
 
 
 def _reader(fields: list[tuple[int, int, bool]]) -> tuple[struct.Struct, list[int]]:
@@ -304,17 +296,11 @@ class _OneEnv:
         tails: list[float] = []
         for get, terms in zip(self.getters, self.terms, strict=True):
             dx, dy, dz, rx, ry, rz, t = get(fields)
-            (on, safe, c0x, c0y, c0z, nvx, nvy, nvz, ix, iy, iz, vx, vy, vz, rates_in,
-             rates_out, has_next, c1x, c1y, c1z, next_span, has, last) = terms  # fmt: skip
-            if t >= 0.0 and on:
-                f = t / safe
-                raw += (dx - c0x * f, dy - c0y * f, dz - c0z * f, rx - ix, ry - iy, rz - iz)
-                raw += rates_in
-                phase = has * (0.0 if f <= 0.0 else 1.0 if f >= 1.0 else f)
-            else:
-                raw += (dx - nvx * t, dy - nvy * t, dz - nvz * t, rx - vx, ry - vy, rz - vz)
-                raw += rates_out
-                phase = has * 0.0
+            c0, span, v_end, next_rate, has_next, c1x, c1y, c1z, next_span, has, last = terms
+            (sx, sy, sz), (vx, vy, vz), running, f = on_schedule(c0, span, v_end, t)
+            raw += (dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz)
+            raw += next_rate
+            phase = has * ((0.0 if f <= 0.0 else 1.0 if f >= 1.0 else f) if running else 0.0)
             raw += (-dx, -dy, -dz)
             if has_next:
                 raw += (-(dx + c1x), -(dy + c1y), -(dz + c1z))

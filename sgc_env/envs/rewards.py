@@ -15,9 +15,7 @@ agent observes plus the goal errors of that tick.
 ``tracking`` (every id's), per step::
 
     r = mean_b sum_tracks 1 / (1 + x) + 0.01 (1 - mean(a^2)) + bonuses
-    x = |D - D_sched| / L
-    D_sched = D_i(0) * time_left / T_i            before and on the goal's tick
-    D_sched = - v_end * time_left                 after the last goal (time_left < 0)
+    x = |D - D_sched| / L        D_sched: the course on schedule (:mod:`sgc_env.envs.schedule`)
     bonuses = sum over goals met this tick of exp(-|D| / 0.01 m) (+ exp(-|phi| / 0.02 rad))
 
 with ``L = max(|D_i(0)|, 0.1 m)`` and, for orientation, ``phi`` in place of ``D`` and
@@ -27,8 +25,8 @@ in its neutral member (``k = 1``, ``a = b = 0``): the course travelled at its av
 schedule. It depends only on the course (``D_i(0)``, ``T_i``) and the clock, never on the
 agent's own state, so the score is highest only for a body that is where the course says it
 should be *now*: arriving early and hovering on the nail scores less, as does arriving late, and
-the tick's bonus pays only for exactness on the tick. After the last goal the body should carry
-on at the goal's end velocity. The SGC expert departs from the neutral course only by its
+the tick's bonus pays only for exactness on the tick. The SGC
+expert departs from the neutral course only by its
 smooth start (it enters each course with the previous course's end velocity), so it earns near
 the maximum. Why this form: every step alive earns between 0 and the number of tracks, so
 leaving the workspace loses what the rest of the episode would have paid (no lump charge that a
@@ -48,6 +46,7 @@ import numpy as np
 from sgc_env.paper.elementwise import all_, any_, at_least, sqrt, where
 
 from .choices import choose
+from .schedule import on_schedule
 
 if TYPE_CHECKING:
     from .task import GoalEvent, GoalTask
@@ -145,18 +144,9 @@ def effort(step: StepScore) -> Any:
 
 
 def schedule_error(d: Sequence[Any], left: Any, c: Sequence[Any], floor: float) -> Any:
-    """``|D - D_sched| / L`` (see the module docstring), uncapped."""
-    ahead = left >= 0.0
-    if ahead is True or ahead is not False and all_(ahead):  # one value inline: elementwise
-        f = left / c[3]
-        rx, ry, rz = c[0] * f, c[1] * f, c[2] * f
-    elif not any_(ahead):
-        rx, ry, rz = -c[8] * left, -c[9] * left, -c[10] * left
-    else:
-        f = left / c[3]
-        rx = where(ahead, c[0] * f, -c[8] * left)
-        ry = where(ahead, c[1] * f, -c[9] * left)
-        rz = where(ahead, c[2] * f, -c[10] * left)
+    """``|D - D_sched| / L`` (see the module docstring), uncapped: ``c`` is the track's course
+    entries (start, duration, next start and duration, end velocity, flags)."""
+    (rx, ry, rz), _, _, _ = on_schedule(c[0:3], c[3], c[8:11], left)
     ex, ey, ez = d[0] - rx, d[1] - ry, d[2] - rz
     scale = at_least(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), floor)
     return sqrt(ex * ex + ey * ey + ez * ez) / scale

@@ -118,6 +118,9 @@ def test_course_terms_are_the_rules_terms() -> None:
     """Spot check of the cached terms against the rule's own arithmetic."""
     course = [0.3, -0.2, 0.1, 1.5, -0.4, 0.0, 0.2, 0.5, 0.1, 0.2, -0.3, 1.0, 0.0]
     terms = _course_terms(course)
-    assert terms[:2] == (True, 1.5)
-    assert terms[8:11] == (-0.3 / 1.5, 0.2 / 1.5, -0.1 / 1.5)
-    assert terms[14] == (-0.3 / 1.5, 0.2 / 1.5, -0.1 / 1.5, 0.4 / 0.5, -0.0 / 0.5, -0.2 / 0.5)
+    c0, span, v_end, next_rate, has_next, *c1, next_span, has, last = terms
+    assert (c0, span, v_end) == ([0.3, -0.2, 0.1], 1.5, [0.1, 0.2, -0.3])
+    assert next_rate == (0.4 / 0.5, -0.0 / 0.5, -0.2 / 0.5)
+    assert (has_next, c1, next_span, has, last) == (True, [-0.4, 0.0, 0.2], 0.5, 1.0, 0.0)
+    alone = _course_terms([*course[:4], 0.0, 0.0, 0.0, 0.0, *course[8:]])
+    assert alone[3:5] == ((0.0, 0.0, 0.0), False)  # no next course: no next velocity
