@@ -25,13 +25,12 @@ in its neutral member (``k = 1``, ``a = b = 0``): the course travelled at its av
 schedule. It depends only on the course (``D_i(0)``, ``T_i``) and the clock, never on the
 agent's own state, so the score is highest only for a body that is where the course says it
 should be *now*: arriving early and hovering on the nail scores less, as does arriving late, and
-the tick's bonus pays only for exactness on the tick. The SGC
-expert departs from the neutral course only by its
-smooth start (it enters each course with the previous course's end velocity), so it earns near
-the maximum. Why this form: every step alive earns between 0 and the number of tracks, so
-leaving the workspace loses what the rest of the episode would have paid (no lump charge that a
-value function has to predict), and ``1 / (1 + x)`` falls at every distance, so a learner far
-off its schedule still sees a slope.
+the tick's bonus pays only for exactness on the tick. The SGC expert departs from the neutral
+course only by its smooth start (it enters each course with the previous course's end velocity),
+so it earns near the maximum. Why this form: every step alive earns between 0 and the number of
+tracks, so leaving the workspace loses what the rest of the episode would have paid (no lump
+charge that a value function has to predict), and ``1 / (1 + x)`` falls at every distance, so a
+learner far off its schedule still sees a slope.
 """
 
 from __future__ import annotations
