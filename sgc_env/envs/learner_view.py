@@ -298,19 +298,28 @@ class _OneEnv:
             dx, dy, dz, rx, ry, rz, t = get(fields)
             c0, span, v_end, next_rate, has_next, c1x, c1y, c1z, next_span, has, last = terms
             (sx, sy, sz), (vx, vy, vz), running, f = on_schedule(c0, span, v_end, t)
-            raw += (dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz)
-            raw += next_rate
+            nx, ny, nz = next_rate
             phase = has * ((0.0 if f <= 0.0 else 1.0 if f >= 1.0 else f) if running else 0.0)
-            raw += (-dx, -dy, -dz)
-            if has_next:
-                raw += (-(dx + c1x), -(dy + c1y), -(dz + c1z))
-                u = t + next_span
-                ahead = lo if u <= lo else hi if u >= hi else u
-            else:
-                raw += _ZEROS
-                ahead = 0.0
             left = lo if t <= lo else hi if t >= hi else t
-            tails += (phase, has * left, has * ahead, has, last)
+            if has_next:
+                u = t + next_span
+                raw += (
+                    dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz, nx, ny, nz,
+                    -dx, -dy, -dz, -(dx + c1x), -(dy + c1y), -(dz + c1z),
+                )  # fmt: skip
+                tails += (
+                    phase,
+                    has * left,
+                    has * (lo if u <= lo else hi if u >= hi else u),
+                    has,
+                    last,
+                )
+            else:
+                raw += (
+                    dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz, nx, ny, nz,
+                    -dx, -dy, -dz, 0.0, 0.0, 0.0,
+                )  # fmt: skip
+                tails += (phase, has * left, has * 0.0, has, last)
         fraction = fields[self.time_at] * self.inverse_length
         raw += tails
         raw += self.hover
