@@ -6,7 +6,10 @@ every registered id both envs run the same scenario under a hover action in alte
 (``--rounds`` each, the order flipped every round). The best chunk per side is kept, in wall
 time and in process CPU time, so a busy, shared machine only ever slows a chunk down and both
 sides see the same machine. Prints microseconds per step for both and the cost ratio
-new / reference (1.000 = same cost).
+new / reference (1.000 = same cost). A bare PyBullet loop of the new env's physics
+(``bench_env.BareLoop``: the same bodies, substeps, force and torque calls and state reads)
+runs in the same rounds, the fixed reference that neither checkout can slow down: ``new/bare``
+is the new env's step over it.
 
     .venv/bin/python scripts/bench_compare.py --reference /tmp/base [--rounds 40 --chunk 500]
         [--ids SGCRod-v1 SGCPoint-v1] [--pair SGCRod-v1=SGCRod-v0]
@@ -25,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from bench_env import hover_action  # scripts/ is on the path when run as a script
+from bench_env import BareLoop, hover_action  # scripts/ is on the path when run as a script
 
 HERE = Path(__file__).resolve().parents[1]
 
@@ -88,22 +91,26 @@ def main() -> None:
         pairs[f"{newest}={old}"] = old
     print(
         f"{'id':18} {'ref us/step':>12} {'new us/step':>12} {'wall new/ref':>13} "
-        f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12}"
+        f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12} {'bare us':>8} {'new/bare':>9}"
     )
     for env_id, old in pairs.items():
         kwargs, ref_kwargs = new._REGISTRY[env_id.partition("=")[0]][1], reference._REGISTRY[old][1]
         envs = {"ref": fixed_env(reference, ref_kwargs), "new": fixed_env(new, kwargs)}
         action = hover_action(envs["new"])
+        bare = BareLoop(envs["new"])
         best = {side: [float("inf"), float("inf")] for side in envs}
+        best_bare = float("inf")
         for r in range(args.rounds):
             for side in ("ref", "new") if r % 2 == 0 else ("new", "ref"):  # ABBA: no order bias
                 wall, cpu = chunk_us(envs[side], args.chunk, action)
                 best[side] = [min(best[side][0], wall), min(best[side][1], cpu)]
+            best_bare = min(best_bare, bare.run_us(args.chunk))
         (rw, rc), (nw, nc) = best["ref"], best["new"]
         print(
             f"{env_id:18} {rw:12.1f} {nw:12.1f} {nw / rw:13.3f} {rc:11.1f} {nc:11.1f} "
-            f"{nc / rc:12.3f}"
+            f"{nc / rc:12.3f} {best_bare:8.1f} {nw / best_bare:9.2f}"
         )
+        bare.sim.close()
         for env in envs.values():
             env.close()
 

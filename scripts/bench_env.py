@@ -57,20 +57,20 @@ class BareLoop:
         world, ident = pb.WORLD_FRAME, (0.0, 0.0, 0.0, 1.0)
         uids, props, force, torque = self.uids, self.props, self.force, (0.0, 0.0, 0.0)
         use_torque, substeps = self.env.use_torque, self.env.substeps
-        positions = [get_p(u, physicsClientId=c)[0] for u in uids]
+        positions = [get_p(u, c)[0] for u in uids]
         t0 = time.perf_counter()
         for _ in range(steps):
             for _k in range(substeps):
                 for uid in props:
-                    reset(uid, (0.0, 0.0, 1.0), ident, physicsClientId=c)
+                    reset(uid, (0.0, 0.0, 1.0), ident, c)
                 for i, uid in enumerate(uids):
-                    apply_f(uid, -1, force[i], positions[i], world, physicsClientId=c)
+                    apply_f(uid, -1, force[i], positions[i], world, c)
                     if use_torque:
-                        apply_t(uid, -1, torque, world, physicsClientId=c)
-                step(physicsClientId=c)
+                        apply_t(uid, -1, torque, world, c)
+                step(c)
             for i, uid in enumerate(uids):
-                positions[i] = get_p(uid, physicsClientId=c)[0]
-                get_v(uid, physicsClientId=c)
+                positions[i] = get_p(uid, c)[0]
+                get_v(uid, c)
         return (time.perf_counter() - t0) / steps * 1e6
 
 
