@@ -10,7 +10,7 @@ that produced it written in the block, so a table is never typed by hand::
 ``--run`` runs the command first (the scorecard takes about a minute of CPU); without it the
 output the command wrote last is pasted. Every markdown file of the README and ``docs/``
 that holds the block's markers is updated. The leaderboards of ``sgc benchmark`` are pasted
-by ``scripts/paste_leaderboard.py`` (their runs take hours); ``leaderboard-summary`` condenses
+by ``sgc paste`` (their runs take hours); ``leaderboard-summary`` condenses
 the pasted equal wall-clock leaderboard of the stock tools in ``docs/results.md`` (the
 ``stock-leaderboard`` block) into the README's table.
 """
@@ -23,6 +23,8 @@ import shlex
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
+
+from baselines.benchmark.paste import block, markers, replace
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -62,27 +64,6 @@ RESULTS = {
 SUMMARY = "leaderboard-summary"
 SUMMARY_SOURCE = "docs/results.md"
 SUMMARY_MARKER = "stock-leaderboard"
-
-
-def markers(name: str) -> tuple[str, str]:
-    """The begin and end lines of the block called ``name``."""
-    return f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
-
-
-def block(document: str, name: str, where: str) -> str:
-    """The text between the markers of ``name`` (``ValueError`` unless there is one pair)."""
-    begin, end = markers(name)
-    if document.count(begin) != 1 or document.count(end) != 1:
-        raise ValueError(f"{where}: needs exactly one {begin} and one {end} line")
-    return document.split(begin)[1].split(end)[0].strip("\n")
-
-
-def replace(document: str, name: str, body: str, where: str) -> str:
-    """``document`` with the block ``name`` holding ``body``."""
-    block(document, name, where)
-    begin, end = markers(name)
-    head, rest = document.split(begin)
-    return f"{head}{begin}\n{body}\n{end}{rest.split(end)[1]}"
 
 
 def demo_table(rods: list[dict[str, object]]) -> str:

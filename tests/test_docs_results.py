@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 LEADERBOARDS = ("threerod-leaderboard", "stock-leaderboard")
-"""The blocks scripts/paste_leaderboard.py writes (``sgc benchmark`` sweeps, hours each)."""
+"""The blocks ``sgc paste`` writes (``sgc benchmark`` sweeps, hours each)."""
 
 
 def _paste():

@@ -88,7 +88,7 @@ def markdown(rows: Sequence[Mapping[str, Any]], meta: Mapping[str, Any]) -> str:
         f"percentile bootstrap CI over training seeds (Agarwal et al. 2021). Scored on "
         f"{meta['eval_episodes']} held-out episodes per run (reset seeds from "
         f"{meta['test_seed']}); 'best' is the model the learning-curve evaluations (seeds from "
-        f"{meta['eval_seed']}) picked. A goal is met within 2 cm (and 0.05 rad) on its tick.",
+        f"{meta['eval_seed']}) picked. A goal is met within 2 cm (and 0.05 rad) at its own time.",
     ]
     for env_id in sorted({r["env_id"] for r in rows}):
         lines += ["", f"## {env_id}", "", "| " + " | ".join(head) + " |",
