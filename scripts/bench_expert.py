@@ -4,7 +4,7 @@ For each env, measured in the same run and process:
 
 * ``bare``: a bare PyBullet loop doing the same physics as one control step (the substeps,
   applyExternalForce/Torque per body per substep, one state read per body), from
-  ``scripts/bench_env.py``;
+  :mod:`baselines.timing.bare`;
 * ``env``: the env's own ``step`` (hovering action, resets excluded);
 * ``expert``: ``SGCExpert.action`` on observations recorded from expert episodes. Every
   observation is timed ``--repeats`` times in interleaved rounds and its minimum kept (robust to
@@ -21,18 +21,14 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 
 import sgc_env  # noqa: F401  (registers the env ids)
 from baselines.controllers.expert import GOAL_TICK_SLACK, SGCExpert
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_env import BareLoop, env_step_us, fixed_env, hover_action  # noqa: E402
+from baselines.timing.bare import BareLoop, env_step_us, fixed_env, hover_action
 
 ENV_IDS = ("SGCRod-v1", "SGCThreeRods-v2")
 

@@ -37,9 +37,9 @@ def _rss_mb(children: bool) -> float:
 def child(env_id: str, n: int, kind: str, steps: int, rollout: int) -> dict[str, float]:
     """One measurement (runs in its own process)."""
     import numpy as np
-    from bench_env import hover_action  # scripts/ is on the path when run as a script
 
     from baselines.agents.sb3_vec_env import BatchedVecEnv, make_sgc_vec
+    from baselines.timing.bare import hover_action
 
     before = _rss_mb(False)
     env = BatchedVecEnv(env_id, n) if kind == "batched" else make_sgc_vec(env_id, n, vec=kind)

@@ -24,10 +24,10 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from bench_env import hover_action  # scripts/ is on the path when run as a script
 
 import sgc_env
 from baselines.agents.sb3_vec_env import make_sgc_vec
+from baselines.timing.bare import hover_action
 from sgc_env.envs.sgc_env import SGCEnv
 from sgc_env.envs.vector.batch import check_num_envs
 from sgc_env.scenes import family

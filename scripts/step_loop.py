@@ -13,7 +13,6 @@ difference of the counts; instruction counts, unlike timings, do not change on a
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 
@@ -23,10 +22,10 @@ def main() -> None:
     parser.add_argument("--env", default="point")
     parser.add_argument("--steps", type=int, default=1000)
     args = parser.parse_args()
-    sys.path.insert(0, str(args.checkout.resolve()))
-    from bench_env import hover_action  # scripts/ is on the path; imports that sgc_env
+    from baselines.timing.bare import hover_action
+    from baselines.timing.checkouts import load_sgc_env
 
-    from sgc_env.envs import SGCEnv
+    SGCEnv = load_sgc_env(args.checkout.resolve()).envs.SGCEnv  # noqa: N806  (the checkout's class)
 
     preset = args.env in ("point", "rod")
     made = SGCEnv(random_scenario=args.env) if preset else SGCEnv(args.env)

@@ -104,6 +104,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("baselines.agents",),  # training, demonstrations, cloning
     ("baselines.benchmark",),  # grids of training runs and their leaderboard
     ("baselines.zoo",),  # the shipped models: manifest and cards
+    ("baselines.timing",),  # how fast the envs run against a bare PyBullet loop
     ("baselines.cli",),  # the `sgc` command
 )  # fmt: skip
 """The parts of ``sgc_env`` and ``baselines``, bottom up: a part imports only parts of lower

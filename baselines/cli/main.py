@@ -25,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "benchmark": "train recipes x envs x seeds (local pool or Ray); leaderboard with IQM and CIs",
     "card": "write the model cards of shipped models, with a fresh held-out evaluation",
     "convert": "trusted SB3 / rl-zoo3 statistics (.pkl) and models into files loaded unpickled",
+    "bench": "how fast the envs run here: against a bare PyBullet loop, or another checkout",
     "paste": "paste a leaderboard of sgc benchmark into markdown documents, between markers",
 }
 

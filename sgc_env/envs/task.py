@@ -9,7 +9,7 @@ desired goal) that HER relabels. It picks no reward (the env scores its mode,
 :mod:`sgc_env.envs.rewards`) and never calls PyBullet: it is handed the bodies' states.
 
 The per-step work is the measurement rule (:mod:`.measure`) on Python tuples, not numpy: for a
-few bodies that is several times cheaper (``scripts/bench_env.py``). The batched env runs the
+few bodies that is several times cheaper (``sgc bench env``). The batched env runs the
 same rule on arrays over its sub-envs and moves a sub-env to its next goals with this class's
 :meth:`GoalTask.advance` (goal ticks are rare).
 """

@@ -8,18 +8,12 @@ import pytest
 
 import sgc_env  # noqa: F401
 from sgc_env.envs.sgc_env import SGCEnv
-from tests.script_module import SCRIPTS, load_script
+from tests.script_module import load_script
 
 
 @pytest.fixture(scope="module")
 def split():
-    import sys
-
-    sys.path.insert(0, str(SCRIPTS))  # the script imports bench_env as its neighbour
-    try:
-        yield load_script("bench_vec_split")
-    finally:
-        sys.path.remove(str(SCRIPTS))
+    return load_script("bench_vec_split")
 
 
 def test_timers_count_resets_and_draws_then_restore(split):
