@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Build the wheel, install it into a fresh venv outside the checkout (torch==2.13.0, the rl
 # extra, constraints.txt), then train and evaluate from another directory: package data
-# (hyperparameters, scenarios, shipped models) must come from the wheel, not the checkout.
+# (hyperparameters, scenarios, shipped models) must come from the wheel, not the checkout; and
+# time one env against the bare PyBullet loop (sgc bench), as a user comparing machines does.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
@@ -36,4 +37,8 @@ step "4/4 sgc evaluate: the expert and the shipped model of the point (a clone)"
 test -s evaluate/scorecard.md && test -s train/final_model.zip
 "$work/venv/bin/sgc" demo --no-video --out demo  # the glTF file and its viewer page, from the wheel
 test -s demo/three_rods.glb && grep -q GLTFLoader demo/viewer.html
+# a timing comparison from the wheel: the env against the bare loop of its physics
+"$work/venv/bin/sgc" bench env --ids SGCPoint-v1 --steps 200 --resets 10 --rounds 2 --draws 2 \
+    | tee bench.txt
+grep -q "^SGCPoint-v1 " bench.txt
 step "wheel check passed"
