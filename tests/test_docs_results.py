@@ -12,6 +12,7 @@ import shlex
 from pathlib import Path
 
 import pytest
+import yaml
 
 from baselines.cli.main import main
 from tests.script_module import load_script
@@ -99,3 +100,17 @@ def test_a_table_needs_its_markers_once() -> None:
         paste.replace(doc, "demo", "new", "d")
         == "a\n<!-- demo:begin -->\nnew\n<!-- demo:end -->\nb"
     )
+
+
+def test_the_stock_leaderboard_has_a_row_for_every_budget_recipe() -> None:
+    """Every family at equal wall clock: each budget recipe of benchmarks/recipes.yml has its
+    10-seed row in the pasted leaderboard, and its Reproduce line names them all."""
+    recipes = yaml.safe_load((ROOT / "benchmarks" / "recipes.yml").read_text())["recipes"]
+    budgets = [r["name"] for r in recipes if r.get("time_budget_s")]
+    body = paste.block((ROOT / "docs" / "results.md").read_text(), "stock-leaderboard", "results")
+    rows = {line.split("|")[1].strip(): line.split("|")[4].strip()
+            for line in body.splitlines() if line.startswith("| ") and "---" not in line
+            and not line.startswith("| recipe ")}  # fmt: skip
+    assert sorted(rows) == sorted(budgets) and set(rows.values()) == {"10"}
+    only = re.search(r"--only (\S+)", body)
+    assert only is not None and sorted(only.group(1).split(",")) == sorted(budgets)
