@@ -302,24 +302,16 @@ class _OneEnv:
             phase = has * ((0.0 if f <= 0.0 else 1.0 if f >= 1.0 else f) if running else 0.0)
             left = lo if t <= lo else hi if t >= hi else t
             if has_next:
+                gx, gy, gz = -(dx + c1x), -(dy + c1y), -(dz + c1z)
                 u = t + next_span
-                raw += (
-                    dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz, nx, ny, nz,
-                    -dx, -dy, -dz, -(dx + c1x), -(dy + c1y), -(dz + c1z),
-                )  # fmt: skip
-                tails += (
-                    phase,
-                    has * left,
-                    has * (lo if u <= lo else hi if u >= hi else u),
-                    has,
-                    last,
-                )
+                ahead = lo if u <= lo else hi if u >= hi else u
             else:
-                raw += (
-                    dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz, nx, ny, nz,
-                    -dx, -dy, -dz, 0.0, 0.0, 0.0,
-                )  # fmt: skip
-                tails += (phase, has * left, has * 0.0, has, last)
+                gx = gy = gz = ahead = 0.0
+            raw += (
+                dx - sx, dy - sy, dz - sz, rx - vx, ry - vy, rz - vz, vx, vy, vz, nx, ny, nz,
+                -dx, -dy, -dz, gx, gy, gz,
+            )  # fmt: skip
+            tails += (phase, has * left, has * ahead, has, last)
         fraction = fields[self.time_at] * self.inverse_length
         raw += tails
         raw += self.hover
