@@ -63,23 +63,24 @@ def _fixed_env(package: Any, kwargs: dict[str, Any]) -> Any:
 
 
 def compare_checkouts(
-    reference: Path, pairs: dict[str, str] | None, rounds: int, chunk: int
+    reference: Path, pairs: list[tuple[str, str]] | None, rounds: int, chunk: int
 ) -> Iterator[str]:
-    """The comparison's lines. ``pairs``: this checkout's id -> the reference's id (another
-    version of the same task, on the same scene); None: every id both register."""
+    """The comparison's lines, one per pair in order. ``pairs``: (this checkout's id, the
+    reference's id: the same id, or another version of the same task on the same scene);
+    None: every id both register."""
     ref = load_sgc_env(reference)
     new = load_sgc_env(None)
     if pairs is None:
-        pairs = {k: k for k, v in new._REGISTRY.items()
-                 if v[0].endswith(":SGCEnv") and k in ref._REGISTRY}  # fmt: skip
-    for newest, old in pairs.items():
+        pairs = [(k, k) for k, v in new._REGISTRY.items()
+                 if v[0].endswith(":SGCEnv") and k in ref._REGISTRY]  # fmt: skip
+    for newest, old in pairs:
         if newest not in new._REGISTRY or old not in ref._REGISTRY:
             raise ValueError(f"{newest}={old}: NEW must be registered here and OLD at {reference}")
     yield (
         f"{'id':18} {'ref us/step':>12} {'new us/step':>12} {'wall new/ref':>13} "
         f"{'ref cpu us':>11} {'new cpu us':>11} {'cpu new/ref':>12} {'bare us':>8} {'new/bare':>9}"
     )
-    for newest, old in pairs.items():
+    for newest, old in pairs:
         envs = {"ref": _fixed_env(ref, ref._REGISTRY[old][1]),
                 "new": _fixed_env(new, new._REGISTRY[newest][1])}  # fmt: skip
         action = hover_action(envs["new"])

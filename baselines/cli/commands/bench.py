@@ -60,10 +60,7 @@ def run(args: argparse.Namespace) -> int:
 
     if not (args.reference / "sgc_env" / "__init__.py").is_file():
         raise UsageError(f"--reference {args.reference}: holds no sgc_env/ package")
-    pairs = None
-    if args.ids or args.pair:
-        pairs = {env_id: env_id for env_id in args.ids or []}
-        pairs.update(dict(args.pair))
+    pairs = [(env_id, env_id) for env_id in args.ids or []] + args.pair or None
     lines = compare_checkouts(args.reference, pairs, args.rounds, args.chunk)
     try:
         print(next(lines), flush=True)  # the ids are checked before the header

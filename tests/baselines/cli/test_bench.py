@@ -39,6 +39,16 @@ def test_compare_against_a_checkout_with_the_bare_loop() -> None:
     assert name == "SGCPoint-v1" and all(float(x) > 0.0 for x in figures)
 
 
+def test_compare_runs_every_pair_asked_for() -> None:
+    """An id in --ids and again in --pair, or twice in --pair, is timed each time it is named."""
+    done = _sgc("bench", "compare", "--reference", str(ROOT), "--ids", "SGCPoint-v1",
+                "--pair", "SGCPoint-v1=SGCPoint-v1", "--pair", "SGCPoint-v1=SGCPoint-v1",
+                "--rounds", "1", "--chunk", "5")  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    rows = done.stdout.strip().splitlines()[1:]
+    assert [row.split()[0] for row in rows] == ["SGCPoint-v1"] * 3
+
+
 def test_a_bad_reference_or_pair_is_one_line(tmp_path: Path) -> None:
     done = _sgc("bench", "compare", "--reference", str(tmp_path), "--rounds", "1")
     assert done.returncode == 2 and done.stdout == ""
