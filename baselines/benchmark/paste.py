@@ -70,9 +70,9 @@ def _sections(body: str, where: str) -> tuple[list[str], dict[str, list[str]]]:
     return preamble, tables
 
 
-def _command(preamble: list[str], where: str) -> tuple[list[str], list[str]]:
-    """The ``Reproduce`` command's words with the options a merge may differ in cut out
-    (``--only``; ``--workers``, the pool's size, which changes no run), and its ``--only``."""
+def _command(preamble: list[str], where: str) -> tuple[list[str], list[str], list[str]]:
+    """The ``Reproduce`` command's words; those words with the options a merge may differ in
+    cut out (``--only``; ``--workers``, the pool's size, which changes no run); its ``--only``."""
     for line in preamble:
         if line.startswith("Reproduce: `") and line.endswith("`"):
             words = shlex.split(line[len("Reproduce: `") : -1])
@@ -88,8 +88,21 @@ def _command(preamble: list[str], where: str) -> tuple[list[str], list[str]]:
                     kept.append(word)
             if not only:
                 raise ValueError(f"{where}: its Reproduce command has no --only list to merge")
-            return kept, only
+            return words, kept, only
     raise ValueError(f"{where}: no 'Reproduce: `...`' line")
+
+
+def _with_only(words: list[str], only: list[str]) -> list[str]:
+    """``words`` with ``only`` as the ``--only`` list (``--only LIST`` or ``--only=LIST``)."""
+    out: list[str] = []
+    pairs = iter(words)
+    for word in pairs:
+        if word == "--only":
+            out += [word, ",".join(only)]
+            next(pairs, None)
+        else:
+            out.append("--only=" + ",".join(only) if word.startswith("--only=") else word)
+    return out
 
 
 def merge(pasted: str, new: str, where: str) -> str:
@@ -97,15 +110,17 @@ def merge(pasted: str, new: str, where: str) -> str:
     a document holds, ``new`` the body of a leaderboard written since."""
     old_pre, old_tables = _sections(pasted, f"{where} (pasted)")
     new_pre, new_tables = _sections(new, f"{where} (new)")
-    old_command, old_only = _command(old_pre, f"{where} (pasted)")
-    new_command, new_only = _command(new_pre, f"{where} (new)")
+    _, old_command, old_only = _command(old_pre, f"{where} (pasted)")
+    new_words, new_command, new_only = _command(new_pre, f"{where} (new)")
     if old_command != new_command:
         raise ValueError(
             f"{where}: the leaderboards come from different commands (--only aside):\n"
             f"  pasted: {shlex.join(old_command)}\n  new:    {shlex.join(new_command)}"
         )
     only = old_only + [name for name in new_only if name not in old_only]
-    lines = [_union_line(line, only) for line in "\n".join(new_pre).strip().splitlines()]
+    reproduce = "Reproduce: `" + shlex.join(_with_only(new_words, only)) + "`"
+    lines = [reproduce if line.startswith("Reproduce: `") else line
+             for line in "\n".join(new_pre).strip().splitlines()]  # fmt: skip
     for env_id in sorted(old_tables.keys() | new_tables.keys()):
         old, fresh = old_tables.get(env_id, []), new_tables.get(env_id, [])
         if old and fresh and old[:2] != fresh[:2]:
@@ -114,15 +129,6 @@ def merge(pasted: str, new: str, where: str) -> str:
         rows.update({_recipe(row): row for row in fresh[2:]})
         lines += ["", f"### {env_id}", "", *(fresh or old)[:2], *(rows[k] for k in sorted(rows))]
     return "\n".join(lines).strip()
-
-
-def _union_line(line: str, only: list[str]) -> str:
-    """The ``Reproduce`` line with the union's ``--only`` list; any other line as it is."""
-    if not line.startswith("Reproduce: `"):
-        return line
-    words = shlex.split(line[len("Reproduce: `") : -1])
-    k = words.index("--only")
-    return "Reproduce: `" + shlex.join([*words[: k + 1], ",".join(only), *words[k + 2 :]]) + "`"
 
 
 def _recipe(row: str) -> str:

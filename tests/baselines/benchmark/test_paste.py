@@ -71,3 +71,11 @@ def test_a_merge_refuses_other_commands_and_other_columns() -> None:
         merge(pasted, leaderboard_body(wider), "doc")
     with pytest.raises(ValueError, match="no --only list"):
         merge(pasted.replace("--only b ", ""), leaderboard_body(_board("a", {})), "doc")
+
+
+def test_a_merge_reads_either_spelling_of_only() -> None:
+    pasted = leaderboard_body(_board("b", {"P-v1": ["b | old"]}))
+    new = leaderboard_body(_board("a", {"P-v1": ["a | new"]}).replace("--only a", "--only=a"))
+    merged = merge(pasted, new, "doc")
+    assert "`sgc benchmark --only=b,a --seeds 10 --workers 2`" in merged
+    assert merged.index("| a | new |") < merged.index("| b | old |")
